@@ -1,0 +1,12 @@
+"""orbit_env: satellite decay by Okhotsimsky, Eneev and Taratynova (1957).
+
+A fast orbit-averaged decay simulator built on the paper's universal curves, and
+Gymnasium environments in which an agent decides when a perigee burn pays off.
+"""
+
+from orbit_env.atmosphere import ExponentialAtmosphere, PaperAtmosphere
+from orbit_env.curves import universal_curves
+from orbit_env.decay import DecayModel
+
+__all__ = ["DecayModel", "ExponentialAtmosphere", "PaperAtmosphere", "universal_curves"]
+__version__ = "0.1.0"

@@ -1,0 +1,289 @@
+"""The paper's universal curves: every decay on one precomputed family, SI units.
+
+Section 3 of the paper: the averaged equations, written per unit of
+nu = N g c s (Eq. 4.1), contain no satellite parameter, so all decays follow one
+one-parameter family of curves in the (perigee, apogee) plane with nu along them
+(the paper's Fig. 2). This module integrates that family once per decay model and
+turns it into two regular tables, so that for any number of satellites
+
+* the remaining lifetime of an orbit (``locate``), and
+* the orbit after K more revolutions (``advance``)
+
+are O(1) bilinear interpolations, vectorized over arrays.
+
+Coordinates. A curve is labelled by mu = ln(e) at re-entry (perigee 100 km): the
+label of the orbit whose decay it is. Along a curve the coordinate is
+tau = ln(1 + nu / NU_REF), with nu the universal lifetime left: linear in nu
+close to re-entry, logarithmic above. For nearly circular orbits the averaged
+equations are linear in e, so there the curves are translates of each other in
+ln(e) and carry the same nu: the tables store ln(e) - mu, which is exact for
+any e below the lowest tabulated curve (circular orbits included).
+
+* Table A, over (perigee height, ln e): mu - ln e, tau, and the mean period q = W/nu.
+* Table B, over (mu, tau): perigee height, ln e - mu, and q.
+
+W = Int P dnu (P the Keplerian period) gives time: t = W / (g c s).
+
+Accuracy: against the averaged ODE solved with DOP853 at rtol 1e-9 the lifetime
+from the curves differs by at most 0.5% for lifetimes nu >= 0.1 (Table II's
+smallest cell) over the domain (``tests/test_curves.py`` measures it on random
+orbits and prints the numbers in ``benchmarks/``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import CubicSpline
+
+from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
+from orbit_env.decay import DecayModel, period_weight_s
+from orbit_env.orbit import _first_bad, elements_from_heights, validate_heights
+
+FloatArray = NDArray[np.float64]
+
+#: Highest perigee height the curves cover [m].
+CURVES_MAX_PERIGEE_M = 1100e3
+#: Highest apogee height the curves cover [m].
+CURVES_MAX_APOGEE_M = 4000e3
+#: nu at which tau = ln(1 + nu / NU_REF) turns from linear to logarithmic.
+NU_REF = 1e-3
+#: Smallest eccentricity resolved; below it an orbit is treated as circular
+#: (the difference in lifetime is below 1e-9 relative).
+E_FLOOR = 1e-14
+
+# The curves run past the domain so that the cells at its edges are valid.
+_HP_TOP_M = CURVES_MAX_PERIGEE_M + 40e3
+_HA_TOP_M = 1.25 * CURVES_MAX_APOGEE_M
+_DH_M = 2e3  # perigee-height step of table A
+_TAU_TOP = 27.0  # nu up to 5e8, beyond any orbit in the domain
+# The lowest curve stays nearly circular (e < 2e-4) up to the top of the domain,
+# where the averaged equations are linear in e and lower curves are its translates.
+_LOWEST_LABEL = float(np.log(1e-9))
+_LABEL_SPACING = 0.1
+_DY = 0.05  # ln(e) spacing of table A
+_DTAU = 0.1  # tau step of the RK4 integration and of table B
+
+
+def _eccentricity(perigee_m: float, apogee_m: float) -> float:
+    rp, ra = EARTH_RADIUS_M + perigee_m, EARTH_RADIUS_M + apogee_m
+    return (ra - rp) / (ra + rp)
+
+
+def _bilinear(
+    table: FloatArray, x0: float, dx: float, y0: float, dy: float, x: FloatArray, y: FloatArray
+) -> FloatArray:
+    """Bilinear interpolation on a regular grid, clamped at its edges."""
+    nx, ny = table.shape
+    fx = np.clip((x - x0) / dx, 0.0, nx - 1.000001)
+    fy = np.clip((y - y0) / dy, 0.0, ny - 1.000001)
+    i = fx.astype(np.intp)
+    j = fy.astype(np.intp)
+    tx = fx - i
+    ty = fy - j
+    return (table[i, j] * (1.0 - tx) + table[i + 1, j] * tx) * (1.0 - ty) + (
+        table[i, j + 1] * (1.0 - tx) + table[i + 1, j + 1] * tx
+    ) * ty
+
+
+@dataclass(frozen=True)
+class CurvePoint:
+    """Orbits located on the universal curves (arrays of the query's shape).
+
+    Attributes:
+        label: mu = ln(e) at re-entry, the curve the orbit decays along.
+        tau: ln(1 + nu / NU_REF), position along the curve.
+        mean_period_s: W / nu, the mean period over the rest of the decay [s].
+    """
+
+    label: FloatArray
+    tau: FloatArray
+    mean_period_s: FloatArray
+
+    @property
+    def nu(self) -> FloatArray:
+        """Universal lifetime left, nu [m^3/(kg s^2)]."""
+        return NU_REF * np.expm1(self.tau)
+
+    @property
+    def weighted_s(self) -> FloatArray:
+        """W = Int P dnu left [s m^3/(kg s^2)]; the time left is W / (g c s)."""
+        return self.mean_period_s * self.nu
+
+
+class UniversalCurves:
+    """The family of decay curves of one :class:`DecayModel`, as lookup tables.
+
+    Build it with :func:`universal_curves` (cached per model). All methods take and
+    return SI arrays and broadcast.
+
+    The curves are integrated backward from re-entry, one every 0.1 in the label
+    mu = ln(e at re-entry), from e = 1e-9 (circular to the top of the domain) to
+    the orbit with a 5000 km apogee at re-entry.
+    """
+
+    def __init__(self, model: DecayModel) -> None:
+        self.model = model
+        self.labels = np.arange(_LOWEST_LABEL, np.log(_eccentricity(REENTRY_ALTITUDE_M, _HA_TOP_M)), _LABEL_SPACING)
+        tau = np.arange(0.0, _TAU_TOP + _DTAU, _DTAU)
+        hp, y, weighted = self._integrate(tau, self.labels)
+        nu = NU_REF * np.expm1(tau)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q = weighted / nu
+        # At re-entry W/nu is the period itself.
+        e_end = np.exp(self.labels)
+        q[:, 0] = period_weight_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
+        self._table_a = self._build_table_a(hp, y, tau, q)
+        self._table_b = self._build_table_b(hp, y, q)
+
+    def _slope(self, hp: FloatArray, y: FloatArray, dnu_dtau: float | FloatArray) -> FloatArray:
+        """d/dtau of perigee height, ln(e) and W, backward from re-entry, one curve each."""
+        e = np.exp(y)
+        p = (EARTH_RADIUS_M + hp) * (1.0 + e)
+        dp_dnu, de_dnu = self.model.rates_per_nu(p, e)
+        dhp_dnu = (dp_dnu * (1.0 + e) - p * de_dnu) / (1.0 + e) ** 2
+        assert np.all(dhp_dnu < 0.0), "perigee height must fall monotonically under drag"
+        return np.stack([-dhp_dnu, -de_dnu / e, period_weight_s(p, e)]) * dnu_dtau
+
+    def _integrate(self, tau: FloatArray, labels: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """RK4 in tau, backward from re-entry, all curves at once.
+
+        tau, not the perigee height, is the variable: elongated orbits lose apogee
+        at an almost constant perigee, where the curves stand nearly vertical.
+        Returns perigee height, ln(e) and W on the tau grid, NaN once a curve has
+        left the domain.
+        """
+        n_curves = labels.size
+        out = np.full((3, n_curves, tau.size), np.nan)
+        state = np.stack([np.full(n_curves, REENTRY_ALTITUDE_M), labels, np.zeros(n_curves)])
+        out[:, :, 0] = state
+        active = np.arange(n_curves)
+        h = _DTAU
+        for index in range(1, tau.size):
+            t = tau[index - 1]
+            s = state[:, active]
+            # nu = NU_REF (e^tau - 1), so dnu/dtau = NU_REF e^tau.
+            d0, d1, d2 = (NU_REF * np.exp(t + x) for x in (0.0, h / 2, h))
+            k1 = self._slope(s[0], s[1], d0)
+            k2 = self._slope(s[0] + h / 2 * k1[0], s[1] + h / 2 * k1[1], d1)
+            k3 = self._slope(s[0] + h / 2 * k2[0], s[1] + h / 2 * k2[1], d1)
+            k4 = self._slope(s[0] + h * k3[0], s[1] + h * k3[1], d2)
+            s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            e = np.exp(s[1])
+            apogee = (EARTH_RADIUS_M + s[0]) * (1 + e) / (1 - e) - EARTH_RADIUS_M
+            keep = np.isfinite(s).all(axis=0) & (e < 0.5) & (apogee <= _HA_TOP_M) & (s[0] <= _HP_TOP_M)
+            active = active[keep]
+            state[:, active] = s[:, keep]
+            out[:, active, index] = s[:, keep]
+            if active.size == 0:
+                break
+        return out[0], out[1], out[2]
+
+    def _build_table_a(self, hp: FloatArray, y: FloatArray, tau: FloatArray, q: FloatArray) -> FloatArray:
+        """Rows of constant ln(e), inverted from the curves to perigee height.
+
+        Under drag e falls monotonically, so every curve crosses a row once, and
+        a row meets the curves in order of their labels (they never cross). Rows,
+        not columns: elongated orbits decay at an almost constant perigee, so the
+        curves stand nearly vertical in (perigee, ln e) and cross rows cleanly.
+        Along a row the values are smooth in perigee height: a cubic spline
+        through the crossings. Beyond the lowest curve (more nearly circular
+        orbits) the curves are translates of it: its values at the same height.
+        """
+        labels = self.labels
+        y_grid = np.arange(labels[0], np.nanmax(y), _DY)
+        hp_grid = np.arange(REENTRY_ALTITUDE_M, _HP_TOP_M, _DH_M)
+        crossing = np.full((3, labels.size, y_grid.size), np.nan)
+        for j in range(labels.size):
+            valid = np.isfinite(hp[j])
+            for row, values in enumerate((hp[j], tau, q[j])):
+                crossing[row, j] = np.interp(y_grid, y[j, valid], values[valid], left=np.nan, right=np.nan)
+        lowest = np.isfinite(hp[0])
+        beyond = [np.interp(hp_grid, hp[0, lowest], v[lowest]) for v in (labels[0] - y[0], tau, q[0])]
+        table = np.empty((3, hp_grid.size, y_grid.size))
+        for m in range(y_grid.size):
+            valid = np.isfinite(crossing[0, :, m])
+            hp_m = crossing[0, valid, m][::-1]
+            assert np.all(np.diff(hp_m) > 0), "decay curves must not cross"
+            values = (labels[valid][::-1] - y_grid[m], crossing[1, valid, m][::-1], crossing[2, valid, m][::-1])
+            inside = hp_grid <= hp_m[-1]
+            for row in range(3):
+                if hp_m.size >= 4:
+                    table[row, inside, m] = CubicSpline(hp_m, values[row])(np.maximum(hp_grid[inside], hp_m[0]))
+                else:
+                    table[row, inside, m] = np.interp(hp_grid[inside], hp_m, values[row])
+                table[row, ~inside, m] = beyond[row][~inside]
+        return table
+
+    def _build_table_b(self, hp: FloatArray, y: FloatArray, q: FloatArray) -> FloatArray:
+        """Each curve at equal steps of tau, held at its last value past its end."""
+        table = np.stack([hp, y - self.labels[:, None], q])
+        last = np.maximum.accumulate(np.where(np.isfinite(hp), np.arange(hp.shape[1]), 0), axis=1)
+        return np.take_along_axis(table, np.broadcast_to(last, table.shape), axis=2)
+
+    @staticmethod
+    def check_domain(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """Validate heights and check that they lie where the curves are tabulated.
+
+        Raises:
+            ValueError: invalid heights, or perigee above ``CURVES_MAX_PERIGEE_M``
+                or apogee above ``CURVES_MAX_APOGEE_M``.
+        """
+        hp, ha = validate_heights(perigee_m, apogee_m)
+        for name, values, limit in (
+            ("perigee", hp, CURVES_MAX_PERIGEE_M),
+            ("apogee", ha, CURVES_MAX_APOGEE_M),
+        ):
+            bad = values > limit
+            if bad.any():
+                raise ValueError(
+                    f"{name} height {_first_bad(values, bad) / 1e3:g} km is outside the universal curves; "
+                    f"allowed: up to {limit / 1e3:g} km (use the averaged ODE for higher orbits)"
+                )
+        return hp, ha
+
+    def locate(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> CurvePoint:
+        """Place orbits on the curves (heights must be valid and in the domain)."""
+        hp = np.asarray(perigee_m, dtype=np.float64)
+        p, e = elements_from_heights(hp, apogee_m)
+        y = np.log(np.maximum(e, E_FLOOR))
+        # Table A holds mu - ln(e), exact for orbits below its lowest row (translates).
+        args = (REENTRY_ALTITUDE_M, _DH_M, float(self.labels[0]), _DY, hp, y)
+        table = self._table_a
+        return CurvePoint(
+            label=y + _bilinear(table[0], *args),
+            tau=np.maximum(_bilinear(table[1], *args), 0.0),
+            mean_period_s=_bilinear(table[2], *args),
+        )
+
+    def at(self, label: ArrayLike, tau: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Perigee height [m], apogee height [m] and mean period left [s] at (label, tau)."""
+        mu = np.asarray(label, dtype=np.float64)
+        t = np.asarray(tau, dtype=np.float64)
+        args = (float(self.labels[0]), _LABEL_SPACING, 0.0, _DTAU, mu, t)
+        table = self._table_b
+        hp = np.maximum(_bilinear(table[0], *args), REENTRY_ALTITUDE_M)
+        e = np.exp(_bilinear(table[1], *args) + mu)
+        rp = EARTH_RADIUS_M + hp
+        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, _bilinear(table[2], *args)
+
+    def advance(self, point: CurvePoint, dnu: ArrayLike) -> CurvePoint:
+        """Move along the curves by ``dnu`` of the universal variable (clamped at re-entry)."""
+        nu = np.maximum(point.nu - np.asarray(dnu, dtype=np.float64), 0.0)
+        tau = np.log1p(nu / NU_REF)
+        _, _, q = self.at(point.label, tau)
+        return CurvePoint(label=np.asarray(point.label, dtype=np.float64), tau=tau, mean_period_s=q)
+
+
+def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0) -> FloatArray:
+    """Universal variable one revolution is worth: dnu/dN = g c s (Eq. 4.1)."""
+    return G0_M_S2 * np.asarray(drag_parameter_m2_kg, dtype=np.float64) * np.asarray(density_scale, dtype=np.float64)
+
+
+@lru_cache(maxsize=8)
+def universal_curves(model: DecayModel | None = None) -> UniversalCurves:
+    """The universal curves of ``model`` (default: the paper's), built once and cached."""
+    return UniversalCurves(model or DecayModel())

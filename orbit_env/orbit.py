@@ -1,0 +1,126 @@
+"""Geometry of the osculating ellipse, SI units (m, m/s, s).
+
+Heights are above the paper's spherical Earth (radius ``EARTH_RADIUS_M``). All
+functions broadcast over numpy arrays. The ``validate_*`` functions are the
+public boundary's checks: they raise ``ValueError`` naming the offending value and
+the allowed range; the other functions assume valid input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, TWO_PI
+
+FloatArray = NDArray[np.float64]
+
+#: Largest apogee height the public functions accept [m] (beyond it the paper's
+#: density law is an extrapolation over more than an Earth radius).
+MAX_APOGEE_M = 50_000e3
+
+
+def _first_bad(values: FloatArray, bad: NDArray[np.bool_]) -> float:
+    return float(np.asarray(values, dtype=np.float64)[np.asarray(bad)].flat[0])
+
+
+def validate_heights(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Check perigee and apogee heights and return them as float arrays.
+
+    Raises:
+        ValueError: a height is NaN or infinite, the perigee is below the 100 km
+            re-entry height, the apogee is below the perigee or above
+            ``MAX_APOGEE_M``. The message names the value and the range.
+    """
+    hp, ha = np.broadcast_arrays(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
+    for name, values in (("perigee", hp), ("apogee", ha)):
+        bad = ~np.isfinite(values)
+        if bad.any():
+            raise ValueError(f"{name} height must be a finite number of km, got {_first_bad(values, bad)!r}")
+    bad = hp < REENTRY_ALTITUDE_M
+    if bad.any():
+        raise ValueError(
+            f"perigee height {_first_bad(hp, bad) / 1e3:g} km is below the re-entry height; "
+            f"allowed: {REENTRY_ALTITUDE_M / 1e3:g} km to {MAX_APOGEE_M / 1e3:g} km"
+        )
+    bad = ha < hp
+    if bad.any():
+        raise ValueError(
+            f"apogee height {_first_bad(ha, bad) / 1e3:g} km is below the perigee height "
+            f"{_first_bad(hp, bad) / 1e3:g} km; the apogee must be >= the perigee"
+        )
+    bad = ha > MAX_APOGEE_M
+    if bad.any():
+        raise ValueError(
+            f"apogee height {_first_bad(ha, bad) / 1e3:g} km is out of range; "
+            f"allowed: perigee to {MAX_APOGEE_M / 1e3:g} km"
+        )
+    return hp, ha
+
+
+def elements_from_heights(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Parameter p [m] and eccentricity e from perigee and apogee heights (section 3)."""
+    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
+    ra = EARTH_RADIUS_M + np.asarray(apogee_m, dtype=np.float64)
+    e = (ra - rp) / (ra + rp)
+    return rp * (1.0 + e), e
+
+
+def heights_from_elements(p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Perigee and apogee heights [m] from p [m] and e (section 3)."""
+    p = np.asarray(p_m, dtype=np.float64)
+    ecc = np.asarray(e, dtype=np.float64)
+    return p / (1.0 + ecc) - EARTH_RADIUS_M, p / (1.0 - ecc) - EARTH_RADIUS_M
+
+
+def semi_major_axis_m(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
+    """Semi-major axis a = p / (1 - e^2) [m]."""
+    ecc = np.asarray(e, dtype=np.float64)
+    return np.asarray(p_m, dtype=np.float64) / (1.0 - ecc * ecc)
+
+
+def period_s(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
+    """Keplerian period 2 pi sqrt(a^3 / fM) [s] of the osculating ellipse."""
+    a = semi_major_axis_m(p_m, e)
+    return TWO_PI * np.sqrt(a**3 / MU_EARTH_M3_S2)
+
+
+def perigee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
+    """Speed at perigee, v_pi = sqrt(fM) (1 + e) / sqrt(p) (section 3) [m/s]."""
+    p, e = elements_from_heights(perigee_m, apogee_m)
+    return np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
+
+
+def apogee_after_perigee_burn_m(perigee_m: ArrayLike, apogee_m: ArrayLike, dv_m_s: ArrayLike) -> FloatArray:
+    """Apogee height [m] after a tangential burn of ``dv_m_s`` at perigee (exact vis-viva).
+
+    A prograde burn at perigee keeps the perigee and raises the apogee. The caller
+    must keep the burn below escape (see :func:`escape_dv_m_s`).
+    """
+    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
+    v = perigee_velocity_m_s(perigee_m, apogee_m) + np.asarray(dv_m_s, dtype=np.float64)
+    inverse_a = 2.0 / rp - v * v / MU_EARTH_M3_S2
+    return 2.0 / inverse_a - rp - EARTH_RADIUS_M
+
+
+def escape_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
+    """Perigee burn [m/s] that would reach escape speed sqrt(2 fM / r_p)."""
+    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
+    return np.sqrt(2.0 * MU_EARTH_M3_S2 / rp) - perigee_velocity_m_s(perigee_m, apogee_m)
+
+
+def dv_for_apogee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, target_apogee_m: ArrayLike) -> FloatArray:
+    """Perigee burn [m/s] that raises the apogee to ``target_apogee_m`` (exact vis-viva).
+
+    Raises:
+        ValueError: the heights are invalid, or the target is below the current apogee.
+    """
+    hp, ha = validate_heights(perigee_m, apogee_m)
+    _, target = validate_heights(hp, target_apogee_m)
+    bad = target < ha
+    if bad.any():
+        raise ValueError(
+            f"target apogee {_first_bad(target, bad) / 1e3:g} km is below the current apogee "
+            f"{_first_bad(ha, bad) / 1e3:g} km; a perigee burn only raises the apogee"
+        )
+    return perigee_velocity_m_s(hp, target) - perigee_velocity_m_s(hp, ha)
