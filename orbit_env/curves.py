@@ -248,7 +248,7 @@ class UniversalCurves:
     def locate(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> CurvePoint:
         """Place orbits on the curves (heights must be valid and in the domain)."""
         hp = np.asarray(perigee_m, dtype=np.float64)
-        p, e = elements_from_heights(hp, apogee_m)
+        _, e = elements_from_heights(hp, apogee_m)
         y = np.log(np.maximum(e, E_FLOOR))
         # Table A holds mu - ln(e), exact for orbits below its lowest row (translates).
         args = (REENTRY_ALTITUDE_M, _DH_M, float(self.labels[0]), _DY, hp, y)

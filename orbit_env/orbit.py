@@ -94,13 +94,14 @@ def perigee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArra
 def apogee_after_perigee_burn_m(perigee_m: ArrayLike, apogee_m: ArrayLike, dv_m_s: ArrayLike) -> FloatArray:
     """Apogee height [m] after a tangential burn of ``dv_m_s`` at perigee (exact vis-viva).
 
-    A prograde burn at perigee keeps the perigee and raises the apogee. The caller
+    A prograde burn (``dv_m_s >= 0``) at perigee keeps the perigee and raises the
+    apogee; the result is clamped so that round-off never lowers it. The caller
     must keep the burn below escape (see :func:`escape_dv_m_s`).
     """
     rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
     v = perigee_velocity_m_s(perigee_m, apogee_m) + np.asarray(dv_m_s, dtype=np.float64)
     inverse_a = 2.0 / rp - v * v / MU_EARTH_M3_S2
-    return 2.0 / inverse_a - rp - EARTH_RADIUS_M
+    return np.maximum(2.0 / inverse_a - rp - EARTH_RADIUS_M, np.asarray(apogee_m, dtype=np.float64))
 
 
 def escape_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
@@ -117,10 +118,10 @@ def dv_for_apogee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, target_apogee_m
     """
     hp, ha = validate_heights(perigee_m, apogee_m)
     _, target = validate_heights(hp, target_apogee_m)
-    bad = target < ha
+    bad = target < ha - 1e-3  # 1 mm of round-off slack
     if bad.any():
         raise ValueError(
             f"target apogee {_first_bad(target, bad) / 1e3:g} km is below the current apogee "
             f"{_first_bad(ha, bad) / 1e3:g} km; a perigee burn only raises the apogee"
         )
-    return perigee_velocity_m_s(hp, target) - perigee_velocity_m_s(hp, ha)
+    return np.maximum(perigee_velocity_m_s(hp, target) - perigee_velocity_m_s(hp, ha), 0.0)

@@ -1,0 +1,258 @@
+"""The lifetime of one satellite: the Python API behind ``orbit-env lifetime``.
+
+This is the public edge, so heights are in km and every input is checked here
+(``ValueError`` naming the value and the allowed range); the physics below is SI.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from orbit_env.atmosphere import Atmosphere, PaperAtmosphere
+from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.curves import NU_REF, nu_per_revolution, universal_curves
+from orbit_env.decay import DecayModel, integrate_averaged
+from orbit_env.orbit import perigee_velocity_m_s, validate_heights
+
+FloatArray = NDArray[np.float64]
+Method = Literal["averaged", "curves", "direct"]
+METHODS: tuple[str, ...] = ("averaged", "curves", "direct")
+
+#: The paper's example satellite (section 4): a 0.5 m sphere of 10 kg, c_x = 2.
+PAPER_SPHERE_DIAMETER_M = 0.5
+PAPER_SPHERE_MASS_KG = 10.0
+PAPER_DRAG_COEFFICIENT = 2.0
+
+
+def _positive(name: str, value: float) -> float:
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class Satellite:
+    """Drag properties of a satellite.
+
+    Args:
+        drag_coefficient: c_x of Eq. (3.2), referred to ``area_m2``.
+        mass_kg: Mass (the paper's weight G in kgf is numerically the same).
+        area_m2: Reference area F.
+    """
+
+    drag_coefficient: float = PAPER_DRAG_COEFFICIENT
+    mass_kg: float = PAPER_SPHERE_MASS_KG
+    area_m2: float = math.pi * (PAPER_SPHERE_DIAMETER_M / 2) ** 2
+
+    def __post_init__(self) -> None:
+        _positive("drag coefficient c_x", self.drag_coefficient)
+        _positive("mass (kg)", self.mass_kg)
+        _positive("area (m^2)", self.area_m2)
+
+    @classmethod
+    def from_mass_per_area(
+        cls, mass_per_area_kg_m2: float, drag_coefficient: float = PAPER_DRAG_COEFFICIENT
+    ) -> Satellite:
+        """A satellite given by its transverse load G/F [kg/m^2] (Eq. 4.1)."""
+        mass_kg = _positive("mass per area (kg/m^2)", mass_per_area_kg_m2)
+        return cls(drag_coefficient=drag_coefficient, mass_kg=mass_kg, area_m2=1.0)
+
+    @property
+    def mass_per_area_kg_m2(self) -> float:
+        """Transverse load G/F [kg/m^2]."""
+        return self.mass_kg / self.area_m2
+
+    @property
+    def drag_parameter_m2_kg(self) -> float:
+        """Drag parameter c = c_x F / m [m^2/kg] of Eq. (3.4)."""
+        return self.drag_coefficient * self.area_m2 / self.mass_kg
+
+    @property
+    def revolutions_per_nu(self) -> float:
+        """The factor of Eq. (4.1): N = nu (G/F) / (g c_x)."""
+        return self.mass_per_area_kg_m2 / (G0_M_S2 * self.drag_coefficient)
+
+
+@dataclass(frozen=True)
+class DecayHistory:
+    """A decay from the start (index 0) to re-entry; arrays of equal length."""
+
+    revolutions: FloatArray
+    days: FloatArray
+    perigee_km: FloatArray
+    apogee_km: FloatArray
+    nu_remaining: FloatArray
+
+    def rows(self) -> list[dict[str, float]]:
+        """The history as a list of records (for CSV)."""
+        columns = asdict(self)
+        return [{key: float(columns[key][i]) for key in columns} for i in range(self.revolutions.size)]
+
+
+@dataclass(frozen=True)
+class LifetimeResult:
+    """The lifetime of one satellite on one orbit.
+
+    Attributes:
+        perigee_km: Initial perigee height.
+        apogee_km: Initial apogee height.
+        nu: The paper's universal lifetime nu [m^3/(kg s^2)] (Table II).
+        revolutions: Revolutions to re-entry, N of Eq. (4.1).
+        days: Time to re-entry, the sum of the periods (not N / 16).
+        perigee_velocity_m_s: Initial speed at perigee (Table II's v_pi).
+        method: ``averaged``, ``curves`` or ``direct``.
+        history: The decay history.
+    """
+
+    perigee_km: float
+    apogee_km: float
+    nu: float
+    revolutions: float
+    days: float
+    perigee_velocity_m_s: float
+    method: str
+    history: DecayHistory = field(repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result without the history, JSON-ready."""
+        return {
+            "perigee_km": self.perigee_km,
+            "apogee_km": self.apogee_km,
+            "nu": self.nu,
+            "revolutions": self.revolutions,
+            "days": self.days,
+            "years": self.days / 365.25,
+            "perigee_velocity_m_s": self.perigee_velocity_m_s,
+            "method": self.method,
+        }
+
+
+def make_satellite(
+    cx: float = PAPER_DRAG_COEFFICIENT,
+    mass_kg: float | None = None,
+    area_m2: float | None = None,
+    mass_per_area_kg_m2: float | None = None,
+) -> Satellite:
+    """Build a :class:`Satellite` from the CLI's options (defaults: the paper's sphere)."""
+    if mass_per_area_kg_m2 is not None:
+        if mass_kg is not None or area_m2 is not None:
+            raise ValueError("give either --mass-per-area or --mass and --area, not both")
+        return Satellite.from_mass_per_area(mass_per_area_kg_m2, cx)
+    if (mass_kg is None) != (area_m2 is None):
+        raise ValueError("give --mass and --area together (or --mass-per-area alone)")
+    if mass_kg is None or area_m2 is None:
+        return Satellite(drag_coefficient=_positive("drag coefficient c_x", cx))
+    return Satellite(drag_coefficient=cx, mass_kg=mass_kg, area_m2=area_m2)
+
+
+def lifetime(
+    perigee_km: float,
+    apogee_km: float,
+    *,
+    satellite: Satellite | None = None,
+    method: Method = "averaged",
+    rho100_kg_m3: float | None = None,
+    density_scale: float = 1.0,
+    atmosphere: Atmosphere | None = None,
+    rotating_atmosphere: bool = False,
+    inclination_deg: float = 0.0,
+) -> LifetimeResult:
+    """Lifetime of a satellite from perigee/apogee heights to re-entry (perigee 100 km).
+
+    Args:
+        perigee_km: Initial perigee height above the spherical Earth.
+        apogee_km: Initial apogee height.
+        satellite: Drag properties (default: the paper's 0.5 m, 10 kg sphere, c_x 2).
+        method: ``averaged`` integrates the orbit-averaged equations (reference),
+            ``curves`` interpolates the universal curves (fast), ``direct``
+            integrates the non-averaged equations of motion (slow; a check).
+        rho100_kg_m3: Override the paper atmosphere's density at 100 km.
+        density_scale: Multiply the density profile.
+        atmosphere: Any density model (replaces the paper's; ``rho100_kg_m3``
+            then does not apply).
+        rotating_atmosphere: Let the air co-rotate with the Earth (section 5).
+        inclination_deg: Orbit inclination (matters with a rotating atmosphere).
+
+    Example:
+        >>> result = lifetime(360, 800)
+        >>> round(result.nu, -1), round(result.revolutions, -2)
+        (2910.0, 7600.0)
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    hp_m, ha_m = (float(x) for x in validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3))
+    satellite = satellite or Satellite()
+    scale = _positive("density scale", density_scale)
+    if atmosphere is None:
+        atmosphere = PaperAtmosphere(scale=scale) if rho100_kg_m3 is None else PaperAtmosphere(rho100_kg_m3, scale)
+    elif rho100_kg_m3 is not None:
+        raise ValueError("rho100_kg_m3 applies to the paper's atmosphere only; scale your own model instead")
+    elif scale != 1.0:
+        raise ValueError("density_scale applies to the paper's atmosphere only; scale your own model instead")
+    model = DecayModel(atmosphere, rotating_atmosphere=rotating_atmosphere, inclination_deg=inclination_deg)
+    per_nu = satellite.revolutions_per_nu
+    to_days = 1.0 / (float(nu_per_revolution(satellite.drag_parameter_m2_kg)) * SECONDS_PER_DAY)
+    if method == "direct":
+        from orbit_env.direct import integrate_direct
+
+        direct = integrate_direct(
+            hp_m,
+            ha_m,
+            satellite.drag_parameter_m2_kg,
+            atmosphere=atmosphere,
+            rotating_atmosphere=rotating_atmosphere,
+            inclination_deg=inclination_deg,
+        )
+        revolutions = direct.revolutions
+        history = DecayHistory(
+            revolutions=direct.history_revolutions,
+            days=direct.history_time_s / SECONDS_PER_DAY,
+            perigee_km=direct.history_perigee_m / 1e3,
+            apogee_km=direct.history_apogee_m / 1e3,
+            nu_remaining=(revolutions - direct.history_revolutions) / per_nu,
+        )
+        nu, days = revolutions / per_nu, direct.time_s / SECONDS_PER_DAY
+    elif method == "curves":
+        curves = universal_curves(model)
+        curves.check_domain(hp_m, ha_m)
+        start = curves.locate(hp_m, ha_m)
+        tau = np.linspace(float(start.tau), 0.0, 200)
+        hp_path, ha_path, mean_period = curves.at(start.label, tau)
+        nu_left = NU_REF * np.expm1(tau)
+        nu, weighted = float(start.nu), float(start.weighted_s)
+        weighted_left = np.concatenate([[weighted], (mean_period * nu_left)[1:]])
+        history = DecayHistory(
+            revolutions=(nu - nu_left) * per_nu,
+            days=(weighted - weighted_left) * to_days,
+            perigee_km=np.concatenate([[hp_m], hp_path[1:]]) / 1e3,
+            apogee_km=np.concatenate([[ha_m], ha_path[1:]]) / 1e3,
+            nu_remaining=nu_left,
+        )
+        revolutions, days = nu * per_nu, weighted * to_days
+    else:
+        path = integrate_averaged(hp_m, ha_m, model)
+        nu, weighted = float(path.nu[-1]), float(path.weighted_s[-1])
+        history = DecayHistory(
+            revolutions=path.nu * per_nu,
+            days=path.weighted_s * to_days,
+            perigee_km=path.perigee_m / 1e3,
+            apogee_km=path.apogee_m / 1e3,
+            nu_remaining=nu - path.nu,
+        )
+        revolutions, days = nu * per_nu, weighted * to_days
+    return LifetimeResult(
+        perigee_km=hp_m / 1e3,
+        apogee_km=ha_m / 1e3,
+        nu=nu,
+        revolutions=revolutions,
+        days=days,
+        perigee_velocity_m_s=float(perigee_velocity_m_s(hp_m, ha_m)),
+        method=method,
+        history=history,
+    )

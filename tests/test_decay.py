@@ -1,0 +1,92 @@
+"""The averaged equations: derivation checks, Table II, the worked examples of section 4."""
+
+import numpy as np
+import pytest
+
+from orbit_env.api import lifetime
+from orbit_env.atmosphere import RHO100_CALIBRATED_KG_M3, PaperAtmosphere
+from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2
+from orbit_env.decay import DecayModel
+from orbit_env.orbit import elements_from_heights
+from orbit_env.table2 import calibrate_rho100, compare_table2
+
+
+def test_circular_orbit_rates_are_closed_form():
+    # e = 0: xi = 1 and 1 + e cos = 1, so dp/dnu = -(2 pi / g) p^2 rho(p - R), de/dnu = 0.
+    model = DecayModel()
+    p = EARTH_RADIUS_M + np.array([150e3, 300e3, 800e3])
+    dp, de = model.rates_per_nu(p, np.zeros(3))
+    rho = model.atmosphere.density_kg_m3(p - EARTH_RADIUS_M)
+    np.testing.assert_allclose(dp, -2 * np.pi / G0_M_S2 * p**2 * rho, rtol=1e-12)
+    # de/dnu vanishes up to round-off of the quadrature sum (relative to dp/dnu / p).
+    assert np.all(np.abs(de) <= 1e-12 * np.abs(dp) / p)
+
+
+def test_quadrature_is_converged():
+    # Trapezoidal rule over the anomaly; the density law's kinks at 150 and 250 km make
+    # it second order there, so the stated error bound is 3e-4 relative (64 vs 1024 points).
+    hp = np.array([100e3, 100e3, 200e3, 300e3, 600e3, 1000e3, 140e3])
+    ha = np.array([100e3, 4000e3, 1600e3, 4000e3, 700e3, 4000e3, 260e3])
+    p, e = elements_from_heights(hp, ha)
+    coarse = DecayModel().rates_per_nu(p, e)
+    fine = DecayModel(quadrature_points=1024).rates_per_nu(p, e)
+    np.testing.assert_allclose(coarse[0], fine[0], rtol=3e-4)
+    # de/dnu of the circular orbit (index 0) is round-off on both sides.
+    np.testing.assert_allclose(coarse[1][1:], fine[1][1:], rtol=3e-4)
+
+
+def test_eccentricity_and_parameter_fall():
+    hp = np.linspace(120e3, 1000e3, 30)
+    p, e = elements_from_heights(hp, hp + 500e3)
+    dp, de = DecayModel().rates_per_nu(p, e)
+    assert np.all(dp < 0) and np.all(de < 0)
+
+
+def test_table2_with_one_calibrated_rho1():
+    # Table II is the paper's Euler solution (steps of 5-10 km in p) with misprints;
+    # the issue's bar: median |error| <= 5%, 90th percentile <= 10% over all 351 cells.
+    comparison = compare_table2()
+    summary = comparison.summary()
+    assert summary["cells"] == 351
+    assert summary["median_abs_rel_error"] <= 0.05
+    assert summary["p90_abs_rel_error"] <= 0.10
+    flagged = {(r["perigee_km"], r["apogee_km"]) for r in comparison.rows() if r["nu_misprint"]}
+    # The known misprints: perigee 320 km, apogee 1100 and 1300 km.
+    assert {(320.0, 1100.0), (320.0, 1300.0)} <= flagged
+    assert len(flagged) <= 10
+
+
+def test_shipped_rho1_is_the_least_squares_fit():
+    assert calibrate_rho100() == pytest.approx(RHO100_CALIBRATED_KG_M3, rel=5e-3)
+
+
+# Section 4's worked examples. The tolerance is Table II's own 90th percentile (10%):
+# the examples are Table II cells read by the authors.
+@pytest.mark.parametrize(("hp", "ha", "nu_paper"), [(360, 800, 2760.0), (500, 1500, 66600.0), (200, 400, 16.8)])
+def test_worked_examples_nu(hp, ha, nu_paper):
+    assert lifetime(hp, ha).nu == pytest.approx(nu_paper, rel=0.10)
+
+
+def test_worked_example_revolutions_and_days_for_the_sphere():
+    result = lifetime(360, 800)  # default: the paper's 0.5 m, 10 kg sphere, c_x = 2
+    assert result.revolutions == pytest.approx(7200, rel=0.10)
+    # The paper divides N by 16 revolutions a day; we integrate the period (94 min mean
+    # here, not 90), which adds 4.6% on top of nu's agreement: 12% in all.
+    assert result.days == pytest.approx(450, rel=0.12)
+    assert result.days / result.revolutions * 1440 == pytest.approx(94.2, abs=0.5)
+    assert lifetime(200, 400).revolutions == pytest.approx(44, rel=0.10)
+
+
+def test_elongated_orbit_multiplies_lifetime_by_2_2():
+    # Section 4: 360 x 700 -> 360 x 1000 km multiplies the lifetime by 2.2.
+    ratio = lifetime(360, 1000).days / lifetime(360, 700).days
+    assert ratio == pytest.approx(2.2, rel=0.10)
+
+
+def test_lifetime_scales_inversely_with_density_and_drag():
+    base = lifetime(300, 600)
+    dense = lifetime(300, 600, density_scale=2.0)
+    assert dense.revolutions == pytest.approx(base.revolutions / 2, rel=1e-6)
+    own = lifetime(300, 600, rho100_kg_m3=2 * RHO100_CALIBRATED_KG_M3)
+    assert own.days == pytest.approx(base.days / 2, rel=1e-6)
+    assert PaperAtmosphere(scale=2.0) != PaperAtmosphere()
