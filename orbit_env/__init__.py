@@ -4,9 +4,18 @@ A fast orbit-averaged decay simulator built on the paper's universal curves, and
 Gymnasium environments in which an agent decides when a perigee burn pays off.
 """
 
+from orbit_env.api import LifetimeResult, Satellite, lifetime
 from orbit_env.atmosphere import ExponentialAtmosphere, PaperAtmosphere
 from orbit_env.curves import universal_curves
 from orbit_env.decay import DecayModel
 
-__all__ = ["DecayModel", "ExponentialAtmosphere", "PaperAtmosphere", "universal_curves"]
+__all__ = [
+    "DecayModel",
+    "ExponentialAtmosphere",
+    "LifetimeResult",
+    "PaperAtmosphere",
+    "Satellite",
+    "lifetime",
+    "universal_curves",
+]
 __version__ = "0.1.0"

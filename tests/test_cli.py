@@ -70,7 +70,8 @@ def test_table2_json(capsys):
 def test_table2_text_summary(capsys):
     status, out, _ = run(capsys, "table2")
     assert status == 0
-    assert out.splitlines()[-1].startswith("351 cells: median |error|")
+    assert out.splitlines()[-2].startswith("351 cells: median |error|")
+    assert out.splitlines()[-1].startswith("with the paper's own Euler scheme")
 
 
 def test_fig2(capsys, tmp_path):
