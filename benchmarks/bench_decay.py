@@ -1,0 +1,71 @@
+"""Speed of the decay simulator, as ratios measured in one run (machines are shared and noisy).
+
+Run: python benchmarks/bench_decay.py
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from orbit_env.curves import UniversalCurves, universal_curves
+from orbit_env.decay import DecayModel, integrate_averaged
+from orbit_env.table2 import load_table2
+
+
+def best_of(repeats: int, function) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    table = load_table2()
+    hp, ha = table.perigee_km * 1e3, table.apogee_km * 1e3
+
+    # 1. All 351 cells of Table II from scratch: build the curves (no cache) and look up.
+    def from_scratch() -> None:
+        UniversalCurves(DecayModel()).locate(hp, ha)
+
+    scratch_s = best_of(3, from_scratch)
+    sample = np.arange(0, hp.size, 10)  # the reference: the averaged ODE, cell by cell
+    ode_s = best_of(1, lambda: [integrate_averaged(hp[k], ha[k]) for k in sample]) * hp.size / sample.size
+    print(f"Table II, 351 cells from scratch (curves built): {scratch_s:.3f} s")
+    print(f"  averaged ODE per cell (DOP853, 35 cells scaled): {ode_s:.2f} s  -> ratio {ode_s / scratch_s:.0f}x")
+
+    # 2. 10^6 random orbits through the cached curves, against one ODE solution.
+    curves = universal_curves()
+    rng = np.random.default_rng(0)
+    n = 1_000_000
+    perigee = rng.uniform(150e3, 1000e3, n)
+    apogee = perigee + rng.uniform(0.0, 1.0, n) * (4000e3 - perigee)
+    lookup_s = best_of(3, lambda: curves.locate(perigee, apogee).nu)
+    one_ode_s = best_of(3, lambda: integrate_averaged(360e3, 800e3))
+    print(f"10^6 lifetimes through the curves (one core): {lookup_s:.3f} s")
+    print(f"  one averaged ODE lifetime: {one_ode_s * 1e3:.1f} ms -> curves are {one_ode_s * n / lookup_s:.0f}x faster per orbit")
+
+    # 3. Advance 10^6 satellites by 1000 revolutions of the paper's sphere.
+    point = curves.locate(perigee, apogee)
+    advance_s = best_of(3, lambda: curves.advance(point, 1000 * 9.81 * 2 * np.pi * 0.0625 / 10))
+    print(f"10^6 satellites advanced by a block of revolutions: {advance_s:.3f} s ({advance_s / lookup_s:.2f}x a lookup)")
+
+    # 4. Averaged against direct on the same orbit (see orbit_env.direct).
+    try:
+        from orbit_env.direct import integrate_direct
+    except ImportError:
+        return
+    c = 2.0 * np.pi * 0.25**2 / 10.0
+    direct_s = best_of(1, lambda: integrate_direct(200e3, 400e3, c))
+    averaged_s = best_of(3, lambda: integrate_averaged(200e3, 400e3))
+    curve_s = best_of(3, lambda: curves.locate(200e3, 400e3))
+    print(f"200 x 400 km, the paper's sphere: direct {direct_s:.2f} s, averaged ODE {averaged_s * 1e3:.1f} ms, "
+          f"curves {curve_s * 1e6:.0f} us")
+    print(f"  direct / averaged ODE = {direct_s / averaged_s:.0f}x, direct / curves = {direct_s / curve_s:.0f}x")
+
+
+if __name__ == "__main__":
+    main()
