@@ -1,0 +1,111 @@
+"""Secular perturbations by the Earth's oblateness: Eqs. (5.5) and (5.6), SI units.
+
+Angles in radians, lengths in metres, times in seconds. Section 5 of the paper
+averages the Gauss equations (2.8) with the perturbing accelerations (5.3) of the
+potential (5.1) over one revolution, elements frozen and gamma = 1. Only the node
+Omega and the argument of perigee omega drift; p, e and i have no secular change,
+which is why the lifetime computation may ignore the oblateness:
+
+    dOmega/dN = -2 pi eps cos(i) / (p^2 fM),               Eq. (5.5)
+    domega/dN =    pi eps (5 cos^2(i) - 1) / (p^2 fM),      Eq. (5.6)
+
+with eps = fM a^2 (alpha - m/2) of Eq. (5.2), equal to fM a^2 (3/2) J2 to first
+order in the flattening (a the equatorial radius). N counts revolutions in the
+argument of latitude u. Note that the rates depend on p alone, not on e.
+
+The per-day rates multiply by the number of Keplerian periods in a day. The paper
+instead divides by a 90-minute orbit (16 revolutions a day, section 4), so its
+per-day figures are some 5% above these at 500 km (see ``docs/validation.md``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, J2_EARTH, MU_EARTH_M3_S2, SECONDS_PER_DAY
+from orbit_env.orbit import _first_bad, period_s
+
+FloatArray = NDArray[np.float64]
+
+#: eps of Eq. (5.2) as fM a^2 (3/2) J2 [m^5/s^2].
+EPSILON_M5_S2 = MU_EARTH_M3_S2 * EARTH_EQUATORIAL_RADIUS_M**2 * 1.5 * J2_EARTH
+
+
+def _check_range(name: str, values: ArrayLike, low: float, high: float, *, high_open: bool = False) -> FloatArray:
+    array = np.asarray(values, dtype=np.float64)
+    bad = ~np.isfinite(array) | (array < low) | ((array >= high) if high_open else (array > high))
+    if bad.any():
+        bracket = ")" if high_open else "]"
+        raise ValueError(f"{name} must be in [{low:g}, {high:g}{bracket}, got {_first_bad(array, bad)!r}")
+    return array
+
+
+def _check_p(p_m: ArrayLike) -> FloatArray:
+    # Any orbit that does not cut through the Earth; the formulas themselves only
+    # need p > 0, but a smaller p is certainly a unit mistake (km for m).
+    return _check_range("p_m", p_m, EARTH_EQUATORIAL_RADIUS_M / 2.0, np.inf, high_open=True)
+
+
+def node_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> FloatArray:
+    """Secular drift of the ascending node per revolution [rad], Eq. (5.5).
+
+    Negative (regression) for prograde orbits, zero for polar ones.
+
+    Args:
+        p_m: Parameter (semi-latus rectum) of the orbit [m].
+        inclination_rad: Inclination in [0, pi] [rad].
+
+    Raises:
+        ValueError: ``p_m`` below half the Earth's radius or not finite, or an
+            inclination outside [0, pi].
+    """
+    p = _check_p(p_m)
+    inclination = _check_range("inclination_rad", inclination_rad, 0.0, np.pi)
+    return -2.0 * np.pi * EPSILON_M5_S2 * np.cos(inclination) / (p * p * MU_EARTH_M3_S2)
+
+
+def perigee_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> FloatArray:
+    """Secular drift of the argument of perigee per revolution [rad], Eq. (5.6).
+
+    Positive below the critical inclination arccos(1/sqrt(5)) = 63.4 deg, zero at it.
+
+    Args:
+        p_m: Parameter (semi-latus rectum) of the orbit [m].
+        inclination_rad: Inclination in [0, pi] [rad].
+
+    Raises:
+        ValueError: as :func:`node_rate_rad_per_rev`.
+    """
+    p = _check_p(p_m)
+    cos_i = np.cos(_check_range("inclination_rad", inclination_rad, 0.0, np.pi))
+    return np.pi * EPSILON_M5_S2 * (5.0 * cos_i * cos_i - 1.0) / (p * p * MU_EARTH_M3_S2)
+
+
+def revolutions_per_day(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
+    """Keplerian periods in a day for the orbit (p, e).
+
+    Raises:
+        ValueError: ``p_m`` as in :func:`node_rate_rad_per_rev`, or e outside [0, 1).
+    """
+    p = _check_p(p_m)
+    ecc = _check_range("e", e, 0.0, 1.0, high_open=True)
+    return SECONDS_PER_DAY / period_s(p, ecc)
+
+
+def node_rate_rad_per_day(p_m: ArrayLike, e: ArrayLike, inclination_rad: ArrayLike) -> FloatArray:
+    """Secular drift of the ascending node per day [rad/day]: Eq. (5.5) times revolutions a day.
+
+    Raises:
+        ValueError: as :func:`node_rate_rad_per_rev` and :func:`revolutions_per_day`.
+    """
+    return node_rate_rad_per_rev(p_m, inclination_rad) * revolutions_per_day(p_m, e)
+
+
+def perigee_rate_rad_per_day(p_m: ArrayLike, e: ArrayLike, inclination_rad: ArrayLike) -> FloatArray:
+    """Secular drift of the argument of perigee per day [rad/day]: Eq. (5.6) times revolutions a day.
+
+    Raises:
+        ValueError: as :func:`perigee_rate_rad_per_rev` and :func:`revolutions_per_day`.
+    """
+    return perigee_rate_rad_per_rev(p_m, inclination_rad) * revolutions_per_day(p_m, e)
