@@ -1,0 +1,283 @@
+"""NRLMSIS 2.1 (through ``pymsis``) as an orbit-averaged density profile, SI units.
+
+The decay core needs density against altitude only (``density_kg_m3(altitude_m)``,
+altitude above the package's spherical Earth of radius ``EARTH_RADIUS_M``). NRLMSIS
+gives density at a point: latitude, local solar time, day of year, altitude and the
+solar and geomagnetic indices. :class:`MsisAtmosphere` averages it, once per solar
+condition, into a table of log-density on an altitude grid, and interpolates that.
+
+How the average is taken, and why:
+
+* **Density, not log-density.** The decay rates are linear in density, so the
+  time-average of density is what the orbit average needs.
+* **Latitude: the arcsine law of the inclination.** On a circular orbit of
+  inclination i the argument of latitude u advances uniformly and
+  sin(latitude) = sin(i) sin(u), so the time spent at latitude phi has the density
+  cos(phi) / (pi sqrt(sin^2 i - sin^2 phi)) for |phi| < i (peaks at +-i). For an
+  eccentric orbit the same holds for the perigee region, because J2 turns the line
+  of apsides (the argument of perigee) through all values over the lifetime. We
+  take u at the midpoints of ``LATITUDE_NODES`` equal intervals of [-pi/2, pi/2]:
+  the integrand is smooth and periodic in u, so this midpoint rule converges
+  geometrically (by symmetry it is the 2n-point rule on the full circle).
+* **Local time: uniform.** The orbit plane precesses against the Sun (J2 turns the
+  node by degrees a day while the Sun moves 0.99 deg/day), so over a lifetime every
+  point of the orbit sees every local time. ``LOCAL_TIME_NODES`` equally spaced
+  local times integrate the diurnal, semidiurnal and terdiurnal tides exactly. The
+  exception is a Sun-synchronous orbit: give ``ascending_node_local_time_h`` and
+  the local time then follows the orbit (it is fixed by the node's local time and
+  the argument of latitude).
+* **Season: the year, or one day.** ``day_of_year=None`` averages over
+  ``SEASON_NODES`` days spread evenly over the year (the annual and semiannual
+  variations, +-30% at 400 km, integrate exactly); a number takes that day.
+
+With 12 x 12 x 6 nodes the average differs from one with 48 x 48 x 24 by less than
+0.4% from 200 to 900 km at 51.6 deg (1.1% at 900 km for a polar orbit), far inside
+the model's own uncertainty (~15%).
+* **Geometry.** NRLMSIS wants geodetic altitude; the package's altitude is above a
+  6371 km sphere. A point at radius R + h and latitude phi has a geodetic altitude
+  R + h - a (1 - f sin^2 phi) with the WGS84 a and f: 7 km lower at the equator,
+  14 km higher at the poles, which matters at scale heights of 30-60 km.
+
+The indices are held fixed: F10.7 of the day before (``f107_sfu``), its 81-day
+centred mean (``f107a_sfu``) and the daily Ap (``ap``), all seven Ap slots equal.
+For activity that changes over a lifetime see :mod:`orbit_env.solar`.
+
+Table: ``ALTITUDE_GRID_M`` (0-6000 km, 2 km steps where the scale height is short);
+log-density is interpolated linearly (it is nearly linear between nodes: the
+relative error is below 1e-3 from 150 to 1000 km and below 4e-3 elsewhere,
+measured in ``tests/test_msis.py``),
+and extrapolated above the grid with its top slope. Building a table costs about
+0.3 s (~600 000 NRLMSIS points) and is cached per condition, so the universal
+curves of :mod:`orbit_env.curves` can be built and cached per profile too.
+
+Nothing is downloaded: all indices are given explicitly to ``pymsis``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, EARTH_RADIUS_M
+
+FloatArray = NDArray[np.float64]
+
+#: The message of the ImportError when pymsis is missing.
+MSIS_INSTALL_HINT = "the NRLMSIS atmosphere needs pymsis: pip install 'orbit-env[msis]'"
+
+#: Flattening of the WGS84 ellipsoid (NRLMSIS altitudes are geodetic).
+WGS84_FLATTENING = 1.0 / 298.257223563
+#: Arguments of latitude in the orbit average (midpoints of equal intervals).
+LATITUDE_NODES = 12
+#: Local solar times in the orbit average (uniform over the day).
+LOCAL_TIME_NODES = 12
+#: Days in the average over the year.
+SEASON_NODES = 6
+#: Allowed ranges of the indices (NRLMSIS is fitted to F10.7 of about 60-300 sfu).
+F107_RANGE_SFU = (40.0, 400.0)
+AP_RANGE = (0.0, 400.0)
+
+#: Altitude grid of the tables [m]: fine where the scale height is short.
+ALTITUDE_GRID_M = np.concatenate(
+    [
+        np.arange(0.0, 200e3, 2e3),
+        np.arange(200e3, 1000e3, 5e3),
+        np.arange(1000e3, 2000e3, 20e3),
+        np.arange(2000e3, 6000e3 + 1.0, 100e3),
+    ]
+)
+
+# A reference non-leap year for days of the year; NRLMSIS has no secular trend.
+_REFERENCE_YEAR_START = np.datetime64("2001-01-01T00:00", "s")
+_UT_HOURS = 12.0  # universal time of every sample: longitude then sets the local time
+
+
+def require_pymsis() -> Any:
+    """Import ``pymsis.msis`` or raise an ImportError that names the extra."""
+    try:
+        from pymsis import msis
+    except ImportError as error:  # pragma: no cover - exercised only without pymsis
+        raise ImportError(MSIS_INSTALL_HINT) from error
+    return msis
+
+
+def _check_range(name: str, value: float, low: float, high: float) -> None:
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ValueError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
+
+
+def orbit_samples(
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None = None,
+    latitude_nodes: int = LATITUDE_NODES,
+    local_time_nodes: int = LOCAL_TIME_NODES,
+) -> tuple[FloatArray, FloatArray]:
+    """Latitudes [deg] and local solar times [h] of equally weighted samples of an orbit.
+
+    Uniform local time: the product of the arcsine-law latitudes and uniform local
+    times. Sun-synchronous (node local time given): the points of the orbit itself,
+    u uniform over the full circle, each with its own local time.
+    """
+    sin_i = math.sin(math.radians(inclination_deg))
+    cos_i = math.cos(math.radians(inclination_deg))
+    if ascending_node_local_time_h is None:
+        u = -0.5 * np.pi + (np.arange(latitude_nodes) + 0.5) * np.pi / latitude_nodes
+        lat = np.degrees(np.arcsin(sin_i * np.sin(u)))
+        local_time = (np.arange(local_time_nodes) + 0.5) * 24.0 / local_time_nodes
+        lat_grid, lt_grid = np.meshgrid(lat, local_time, indexing="ij")
+        return lat_grid.ravel(), lt_grid.ravel()
+    u = (np.arange(2 * latitude_nodes) + 0.5) * np.pi / latitude_nodes
+    lat = np.degrees(np.arcsin(sin_i * np.sin(u)))
+    # Right ascension from the node: the Sun's hour angle moves with it (15 deg/h).
+    right_ascension = np.degrees(np.arctan2(cos_i * np.sin(u), np.cos(u)))
+    local_time = np.mod(ascending_node_local_time_h + right_ascension / 15.0, 24.0)
+    return lat, local_time
+
+
+def geodetic_altitude_m(altitude_m: ArrayLike, latitude_deg: ArrayLike) -> FloatArray:
+    """Height above WGS84 of the point at radius EARTH_RADIUS_M + altitude and that latitude."""
+    sin_lat = np.sin(np.radians(np.asarray(latitude_deg, dtype=np.float64)))
+    surface = EARTH_EQUATORIAL_RADIUS_M * (1.0 - WGS84_FLATTENING * sin_lat * sin_lat)
+    return np.asarray(altitude_m, dtype=np.float64) + (EARTH_RADIUS_M - surface)
+
+
+def mean_density_kg_m3(
+    altitude_m: ArrayLike,
+    f107_sfu: float,
+    f107a_sfu: float,
+    ap: float,
+    inclination_deg: float,
+    day_of_year: float | None = None,
+    ascending_node_local_time_h: float | None = None,
+    *,
+    latitude_nodes: int = LATITUDE_NODES,
+    local_time_nodes: int = LOCAL_TIME_NODES,
+    season_nodes: int = SEASON_NODES,
+) -> FloatArray:
+    """NRLMSIS 2.1 density [kg/m^3] averaged over an orbit's latitudes, local times and season.
+
+    The averaging is described in the module docstring. ``altitude_m`` is a 1-D
+    array of heights above the package's spherical Earth.
+    """
+    msis = require_pymsis()
+    alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
+    lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
+    if day_of_year is None:
+        days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
+    else:
+        days = np.array([float(day_of_year) - 1.0])
+    lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
+    n_days, n_samples, n_alt = days.size, lat.size, alt.size
+    shape = (n_days, n_samples, n_alt)
+    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
+    dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[:, None, None], shape).ravel()
+    lats = np.broadcast_to(lat[None, :, None], shape).ravel()
+    lons = np.broadcast_to(lon[None, :, None], shape).ravel()
+    alts_km = geodetic_altitude_m(alt[None, None, :], lat[None, :, None]) / 1e3
+    alts_km = np.broadcast_to(alts_km, shape).ravel()
+    size = dates.size
+    out = msis.calculate(
+        dates,
+        lons,
+        lats,
+        alts_km,
+        f107s=np.full(size, float(f107_sfu)),
+        f107as=np.full(size, float(f107a_sfu)),
+        aps=np.full((size, 7), float(ap)),
+        version=2.1,
+    )
+    rho = np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
+    return rho.mean(axis=(0, 1))
+
+
+@lru_cache(maxsize=256)
+def _log_density_table(
+    f107_sfu: float,
+    f107a_sfu: float,
+    ap: float,
+    inclination_deg: float,
+    day_of_year: float | None,
+    ascending_node_local_time_h: float | None,
+) -> FloatArray:
+    rho = mean_density_kg_m3(
+        ALTITUDE_GRID_M, f107_sfu, f107a_sfu, ap, inclination_deg, day_of_year, ascending_node_local_time_h
+    )
+    assert np.all(np.isfinite(rho) & (rho > 0.0)), "NRLMSIS returned a non-positive density"
+    return np.log(rho)
+
+
+def interpolate_log_density(altitude_m: ArrayLike, log_rho: FloatArray) -> FloatArray:
+    """Density from a log-density table, interpolated at ``altitude_m`` (extrapolated above the top)."""
+    h = np.asarray(altitude_m, dtype=np.float64)
+    grid = ALTITUDE_GRID_M
+    value = np.interp(h, grid, log_rho)
+    top_slope = (log_rho[-1] - log_rho[-2]) / (grid[-1] - grid[-2])
+    return np.exp(np.where(h > grid[-1], log_rho[-1] + top_slope * (h - grid[-1]), value))
+
+
+@dataclass(frozen=True)
+class MsisAtmosphere:
+    """NRLMSIS 2.1 averaged over an orbit, at fixed solar and geomagnetic activity.
+
+    Frozen and hashable: :func:`orbit_env.curves.universal_curves` caches the
+    curves per instance, and the density table is cached per condition.
+
+    Args:
+        f107_sfu: Daily F10.7 of the previous day [sfu = 1e-22 W m^-2 Hz^-1].
+        f107a_sfu: 81-day centred mean of F10.7 [sfu].
+        ap: Daily geomagnetic Ap index.
+        inclination_deg: Orbit inclination: sets the latitudes averaged over.
+        day_of_year: 1-366, or None for the average over the year.
+        ascending_node_local_time_h: Local solar time of the ascending node of a
+            Sun-synchronous orbit [h]; None (default) averages over local time.
+        scale: Multiplier on the whole profile.
+
+    Example:
+        >>> atmosphere = MsisAtmosphere(150.0, 150.0, 15.0, inclination_deg=51.6)
+        >>> 1e-12 < float(atmosphere.density_kg_m3(400e3)) < 1e-11
+        True
+    """
+
+    f107_sfu: float
+    f107a_sfu: float
+    ap: float
+    inclination_deg: float
+    day_of_year: float | None = None
+    ascending_node_local_time_h: float | None = None
+    scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        _check_range("F10.7 (sfu)", self.f107_sfu, *F107_RANGE_SFU)
+        _check_range("81-day mean F10.7 (sfu)", self.f107a_sfu, *F107_RANGE_SFU)
+        _check_range("Ap", self.ap, *AP_RANGE)
+        _check_range("inclination (deg)", self.inclination_deg, 0.0, 180.0)
+        if self.day_of_year is not None:
+            _check_range("day of year", self.day_of_year, 1.0, 367.0)
+        if self.ascending_node_local_time_h is not None:
+            _check_range("local time of the ascending node (h)", self.ascending_node_local_time_h, 0.0, 24.0)
+        if not (math.isfinite(self.scale) and self.scale > 0.0):
+            raise ValueError(f"scale must be a positive finite number, got {self.scale!r}")
+
+    def log_density_table(self) -> FloatArray:
+        """ln(density [kg/m^3]) on ``ALTITUDE_GRID_M``, without ``scale`` (cached)."""
+        return _log_density_table(
+            float(self.f107_sfu),
+            float(self.f107a_sfu),
+            float(self.ap),
+            float(self.inclination_deg),
+            None if self.day_of_year is None else float(self.day_of_year),
+            None if self.ascending_node_local_time_h is None else float(self.ascending_node_local_time_h),
+        )
+
+    def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
+        """Orbit-averaged density [kg/m^3] at altitude [m] above the spherical Earth."""
+        return self.scale * interpolate_log_density(altitude_m, self.log_density_table())
+
+    def with_scale(self, scale: float) -> MsisAtmosphere:
+        """The same atmosphere times ``scale`` (shares the cached table)."""
+        return replace(self, scale=scale)
