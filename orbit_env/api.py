@@ -15,9 +15,13 @@ from numpy.typing import NDArray
 
 from orbit_env.atmosphere import Atmosphere, PaperAtmosphere
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.curves import NU_REF, nu_per_revolution, universal_curves
+from orbit_env.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
 from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.orbit import perigee_velocity_m_s, validate_heights
+from orbit_env.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
+from orbit_env.propagate import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
+from orbit_env.rule import RuleCheck, check_disposal_rule
+from orbit_env.scenario import Scenario
+from orbit_env.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 
 FloatArray = NDArray[np.float64]
 Method = Literal["averaged", "curves", "direct"]
@@ -162,6 +166,10 @@ def lifetime(
     atmosphere: Atmosphere | None = None,
     rotating_atmosphere: bool = False,
     inclination_deg: float = 0.0,
+    activity: SolarActivity | None = None,
+    epoch: str | float | None = None,
+    ascending_node_local_time_h: float | None = None,
+    chunk_days: float = DEFAULT_CHUNK_DAYS,
 ) -> LifetimeResult:
     """Lifetime of a satellite from perigee/apogee heights to re-entry (perigee 100 km).
 
@@ -177,7 +185,21 @@ def lifetime(
         atmosphere: Any density model (replaces the paper's; ``rho100_kg_m3``
             then does not apply).
         rotating_atmosphere: Let the air co-rotate with the Earth (section 5).
-        inclination_deg: Orbit inclination (matters with a rotating atmosphere).
+        inclination_deg: Orbit inclination (matters with a rotating atmosphere,
+            and sets the latitudes NRLMSIS is averaged over).
+        activity: Use NRLMSIS 2.1 under this solar activity
+            (:mod:`orbit_env.solar`; needs pymsis). Constant activity without an
+            epoch is one fixed profile (every method); otherwise the satellite is
+            stepped through time on the universal curves (``method="curves"``,
+            :mod:`orbit_env.propagate`) or, as a slow reference, by the averaged
+            equations with a fresh profile every day (``method="averaged"``).
+        epoch: Date of the orbit (``YYYY-MM-DD``, or unix days). With NRLMSIS it
+            makes the season count, and places the orbit in time-varying activity.
+            None: a table's first date; for other activity day 0 (1970-01-01)
+            with the season averaged (use ``CycleActivity.with_phase(phase, 0.0)``).
+        ascending_node_local_time_h: NRLMSIS, Sun-synchronous orbits: the node's
+            local solar time (else local time is averaged over).
+        chunk_days: Time step of the time-stepped path.
 
     Example:
         >>> result = lifetime(360, 800)
@@ -189,6 +211,41 @@ def lifetime(
     hp_m, ha_m = (float(x) for x in validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3))
     satellite = satellite or Satellite()
     scale = _positive("density scale", density_scale)
+    if activity is not None or epoch is not None:
+        if atmosphere is not None or rho100_kg_m3 is not None:
+            raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
+        if activity is None:
+            raise ValueError("an epoch needs a solar activity (e.g. ConstantActivity(f107, f107a, ap))")
+        if isinstance(activity, ConstantActivity) and epoch is None:
+            from orbit_env.msis import MsisAtmosphere
+
+            atmosphere = MsisAtmosphere(
+                activity.f107_sfu,
+                activity.f107a_sfu,
+                activity.ap,
+                inclination_deg,
+                None,
+                ascending_node_local_time_h,
+                scale,
+            )
+            scale = 1.0
+        else:
+            return _lifetime_under_activity(
+                hp_m,
+                ha_m,
+                satellite,
+                method,
+                scale,
+                SolarDecayModel(
+                    activity,
+                    _start_days(activity, epoch),
+                    inclination_deg,
+                    follow_season=epoch is not None,
+                    rotating_atmosphere=rotating_atmosphere,
+                    ascending_node_local_time_h=ascending_node_local_time_h,
+                    chunk_days=chunk_days,
+                ),
+            )
     if atmosphere is None:
         atmosphere = PaperAtmosphere(scale=scale) if rho100_kg_m3 is None else PaperAtmosphere(rho100_kg_m3, scale)
     elif rho100_kg_m3 is not None:
@@ -256,3 +313,97 @@ def lifetime(
         method=method,
         history=history,
     )
+
+
+def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
+    if epoch is None:
+        return activity.start_days if isinstance(activity, TableActivity) else 0.0
+    if isinstance(epoch, (int, float)):
+        if not math.isfinite(epoch):
+            raise ValueError(f"epoch must be a date or a finite number of unix days, got {epoch!r}")
+        return float(epoch)
+    return unix_days(epoch)
+
+
+def _lifetime_under_activity(
+    hp_m: float, ha_m: float, satellite: Satellite, method: str, scale: float, model: SolarDecayModel
+) -> LifetimeResult:
+    """The time-stepped NRLMSIS lifetime (see :func:`lifetime`)."""
+    if method == "direct":
+        raise ValueError("the direct method needs a fixed atmosphere; with changing solar activity use curves")
+    UniversalCurves.check_domain(hp_m, ha_m)
+    c = satellite.drag_parameter_m2_kg
+    per_nu = satellite.revolutions_per_nu
+    if method == "averaged":
+        days = integrate_reference(hp_m, ha_m, c * scale, model)
+        reentered = days < model.max_years * 365.25
+        t = np.array([0.0, days])
+        hp_path, ha_path = np.array([hp_m, 100e3]), np.array([ha_m, np.nan])
+    else:
+        result = propagate(hp_m, ha_m, c, model, density_scale=scale, record=True)
+        days, reentered = float(result.days[0]), bool(result.reentered[0])
+        inside = result.history_days < days
+        t = np.append(result.history_days[inside], days)
+        hp_path = np.append(result.history_perigee_m[inside, 0], result.history_perigee_m[-1, 0])
+        ha_path = np.append(result.history_apogee_m[inside, 0], result.history_apogee_m[-1, 0])
+    if not reentered:
+        raise ValueError(
+            f"still in orbit after {model.max_years:g} years, where the time-stepped decay stops; "
+            "the lifetime is longer than that"
+        )
+    # Revolutions: Int dt / P, trapezoidal over the recorded orbits (the period changes slowly).
+    if np.all(np.isfinite(ha_path)):
+        inverse_period = 1.0 / period_s(*elements_from_heights(hp_path, ha_path))
+        revolutions = float(np.sum(0.5 * (inverse_period[1:] + inverse_period[:-1]) * np.diff(t)) * SECONDS_PER_DAY)
+    else:
+        revolutions = float(days * SECONDS_PER_DAY / period_s(*elements_from_heights(hp_m, ha_m)))
+    nu = revolutions / per_nu
+    history = DecayHistory(
+        revolutions=np.linspace(0.0, revolutions, t.size),
+        days=t,
+        perigee_km=hp_path / 1e3,
+        apogee_km=ha_path / 1e3,
+        nu_remaining=np.linspace(nu, 0.0, t.size),
+    )
+    return LifetimeResult(
+        perigee_km=hp_m / 1e3,
+        apogee_km=ha_m / 1e3,
+        nu=nu,
+        revolutions=revolutions,
+        days=days,
+        perigee_velocity_m_s=float(perigee_velocity_m_s(hp_m, ha_m)),
+        method=method,
+        history=history,
+    )
+
+
+def check_rule(
+    perigee_km: float,
+    apogee_km: float,
+    rule_years: float,
+    *,
+    satellite: Satellite | None = None,
+    scenario: Scenario | None = None,
+    inclination_deg: float = 0.0,
+) -> RuleCheck:
+    """Does the orbit re-enter within ``rule_years`` (e.g. 25 or 5), and the smallest apogee burn that makes it.
+
+    Lifetimes come from the universal curves of the scenario (time-stepped if it
+    has an epoch), see :mod:`orbit_env.rule`. Heights must lie in the curves'
+    domain (perigee <= 1100 km, apogee <= 4000 km).
+
+    Example:
+        >>> check = check_rule(800, 800, 25, satellite=Satellite(2.2, 100.0, 1.0))
+        >>> bool(check.complies[0]), round(float(check.new_perigee_m[0]) / 1e3)
+        (False, 590)
+    """
+    satellite = satellite or Satellite()
+    scenario = scenario or Scenario()
+    hp_m, ha_m = validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3)
+    c = satellite.drag_parameter_m2_kg
+    cap_days = (float(rule_years) + 1.0) * 365.25
+
+    def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
+        return scenario.lifetime_days(hp, ha, np.full(hp.shape, c), inclination_deg, max_days=cap_days)
+
+    return check_disposal_rule(hp_m, ha_m, rule_years, lifetimes)

@@ -42,7 +42,8 @@ The indices are held fixed: F10.7 of the day before (``f107_sfu``), its 81-day
 centred mean (``f107a_sfu``) and the daily Ap (``ap``), all seven Ap slots equal.
 For activity that changes over a lifetime see :mod:`orbit_env.solar`.
 
-Table: ``ALTITUDE_GRID_M`` (0-6000 km, 2 km steps where the scale height is short);
+Table: ``ALTITUDE_GRID_M`` (40-6000 km, 2 km steps where the scale height is short;
+below 40 km the 40 km value is held: no decay computed here reaches that low);
 log-density is interpolated linearly (it is nearly linear between nodes: the
 relative error is below 1e-3 from 150 to 1000 km and below 4e-3 elsewhere,
 measured in ``tests/test_msis.py``),
@@ -85,7 +86,7 @@ AP_RANGE = (0.0, 400.0)
 #: Altitude grid of the tables [m]: fine where the scale height is short.
 ALTITUDE_GRID_M = np.concatenate(
     [
-        np.arange(0.0, 200e3, 2e3),
+        np.arange(40e3, 200e3, 2e3),
         np.arange(200e3, 1000e3, 5e3),
         np.arange(1000e3, 2000e3, 20e3),
         np.arange(2000e3, 6000e3 + 1.0, 100e3),
@@ -164,13 +165,47 @@ def mean_density_kg_m3(
     The averaging is described in the module docstring. ``altitude_m`` is a 1-D
     array of heights above the package's spherical Earth.
     """
+    if day_of_year is None:
+        days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes + 1.0
+    else:
+        days = np.array([float(day_of_year)])
+    ones = np.ones(days.size)
+    return mean_density_over_days_kg_m3(
+        altitude_m,
+        f107_sfu * ones,
+        f107a_sfu * ones,
+        ap * ones,
+        days,
+        inclination_deg,
+        ascending_node_local_time_h,
+        latitude_nodes=latitude_nodes,
+        local_time_nodes=local_time_nodes,
+    )
+
+
+def mean_density_over_days_kg_m3(
+    altitude_m: ArrayLike,
+    f107_sfu: ArrayLike,
+    f107a_sfu: ArrayLike,
+    ap: ArrayLike,
+    day_of_year: ArrayLike,
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None = None,
+    *,
+    latitude_nodes: int = LATITUDE_NODES,
+    local_time_nodes: int = LOCAL_TIME_NODES,
+) -> FloatArray:
+    """Orbit-averaged NRLMSIS 2.1 density [kg/m^3], averaged again over days with their own indices.
+
+    The k-th day has indices ``f107_sfu[k]``, ``f107a_sfu[k]``, ``ap[k]`` and day of
+    the year ``day_of_year[k]`` (1-366). One NRLMSIS call for all of them. The mean
+    of densities, not the density of mean indices: NRLMSIS responds to Ap
+    concavely, so averaging the indices would overstate the density after storms.
+    """
     msis = require_pymsis()
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
-    if day_of_year is None:
-        days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
-    else:
-        days = np.array([float(day_of_year) - 1.0])
+    days = np.atleast_1d(np.asarray(day_of_year, dtype=np.float64)) - 1.0
     lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
     n_days, n_samples, n_alt = days.size, lat.size, alt.size
     shape = (n_days, n_samples, n_alt)
@@ -180,15 +215,19 @@ def mean_density_kg_m3(
     lons = np.broadcast_to(lon[None, :, None], shape).ravel()
     alts_km = geodetic_altitude_m(alt[None, None, :], lat[None, :, None]) / 1e3
     alts_km = np.broadcast_to(alts_km, shape).ravel()
-    size = dates.size
+
+    def per_point(values: ArrayLike) -> FloatArray:
+        per_day = np.broadcast_to(np.asarray(values, dtype=np.float64), (n_days,))
+        return np.broadcast_to(per_day[:, None, None], shape).ravel()
+
     out = msis.calculate(
         dates,
         lons,
         lats,
         alts_km,
-        f107s=np.full(size, float(f107_sfu)),
-        f107as=np.full(size, float(f107a_sfu)),
-        aps=np.full((size, 7), float(ap)),
+        f107s=per_point(f107_sfu),
+        f107as=per_point(f107a_sfu),
+        aps=np.repeat(per_point(ap)[:, None], 7, axis=1),
         version=2.1,
     )
     rho = np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3

@@ -1,0 +1,115 @@
+"""Disposal-rule check: re-entry within N years, and the smallest perigee-lowering burn that achieves it.
+
+SI units (m, m/s, days). The burn is a single retrograde tangential burn at apogee:
+it keeps the apogee and lowers the perigee (exact vis-viva), the cheapest way to
+shorten the life of a near-circular or eccentric orbit with one burn. Since the
+lifetime grows monotonically with the perigee at a fixed apogee, the smallest burn
+is found by a vectorized search over perigee heights: three passes of
+``CANDIDATES`` heights each, every pass bracketing the highest complying perigee
+16 times more finely (resolution (h_p - 100 km) / 4096, 0.2 km for a 1000 km
+perigee). The perigee reported complies; the burn is rounded up, never down.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M
+
+FloatArray = NDArray[np.float64]
+#: Lifetimes of many (perigee, apogee, satellite index) at once: (days, re-entered).
+LifetimeFunction = Callable[[FloatArray, FloatArray, NDArray[np.intp]], tuple[FloatArray, NDArray[np.bool_]]]
+
+#: Candidate perigees per pass of the search.
+CANDIDATES = 16
+#: Passes of the search.
+PASSES = 3
+DAYS_PER_YEAR = 365.25
+
+
+def apogee_speed_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
+    """Speed at apogee [m/s] (vis-viva)."""
+    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
+    ra = EARTH_RADIUS_M + np.asarray(apogee_m, dtype=np.float64)
+    return np.sqrt(2.0 * MU_EARTH_M3_S2 * rp / (ra * (ra + rp)))
+
+
+def perigee_lowering_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, new_perigee_m: ArrayLike) -> FloatArray:
+    """Retrograde burn at apogee [m/s] that lowers the perigee to ``new_perigee_m``."""
+    return apogee_speed_m_s(perigee_m, apogee_m) - apogee_speed_m_s(new_perigee_m, apogee_m)
+
+
+@dataclass(frozen=True)
+class RuleCheck:
+    """Outcome of :func:`check_disposal_rule`, arrays over satellites.
+
+    Attributes:
+        rule_years: The limit.
+        lifetime_days: Lifetime of the orbit as it is (capped a little beyond the
+            rule on time-stepped paths: then ``reentered`` is False).
+        reentered: False where the satellite was still up at the cap.
+        complies: Lifetime within the rule.
+        new_perigee_m: Perigee after the smallest complying burn (the perigee itself if it complies).
+        dv_m_s: That burn (0 if it complies).
+    """
+
+    rule_years: float
+    lifetime_days: FloatArray
+    reentered: NDArray[np.bool_]
+    complies: NDArray[np.bool_]
+    new_perigee_m: FloatArray
+    dv_m_s: FloatArray
+
+
+def check_disposal_rule(
+    perigee_m: ArrayLike, apogee_m: ArrayLike, rule_years: float, lifetime_days: LifetimeFunction
+) -> RuleCheck:
+    """Check the rule for each satellite and find the smallest complying apogee burn.
+
+    Args:
+        perigee_m: Perigee heights [m].
+        apogee_m: Apogee heights [m].
+        rule_years: Re-entry must come within this many years.
+        lifetime_days: Vectorized lifetimes (see :data:`LifetimeFunction`).
+
+    Raises:
+        ValueError: ``rule_years`` not positive.
+    """
+    if not (np.isfinite(rule_years) and rule_years > 0.0):
+        raise ValueError(f"the rule must be a positive number of years, got {rule_years!r}")
+    hp = np.atleast_1d(np.asarray(perigee_m, dtype=np.float64))
+    ha = np.broadcast_to(np.asarray(apogee_m, dtype=np.float64), hp.shape)
+    limit = rule_years * DAYS_PER_YEAR
+    index = np.arange(hp.size)
+    days, reentered = lifetime_days(hp, ha, index)
+    complies = reentered & (days <= limit)
+    new_hp = hp.copy()
+    todo = np.flatnonzero(~complies)
+    # Bracket [lo, hi]: lo complies (100 km re-enters at once), hi does not.
+    lo = np.full(todo.size, REENTRY_ALTITUDE_M)
+    hi = hp[todo].copy()
+    fractions = np.arange(1, CANDIDATES + 1) / (CANDIDATES + 1)
+    for _ in range(PASSES if todo.size else 0):
+        candidates = lo[:, None] + (hi - lo)[:, None] * fractions[None, :]
+        which = np.repeat(todo, CANDIDATES)
+        cand_days, cand_in = lifetime_days(candidates.ravel(), ha[which], which)
+        ok = (cand_in & (cand_days <= limit)).reshape(candidates.shape)
+        # Monotone in perigee: the highest complying candidate and the next one up bracket the answer.
+        n_ok = ok.sum(axis=1)
+        below = np.where(n_ok > 0, candidates[np.arange(todo.size), np.maximum(n_ok - 1, 0)], lo)
+        above = np.where(n_ok < CANDIDATES, candidates[np.arange(todo.size), np.minimum(n_ok, CANDIDATES - 1)], hi)
+        lo, hi = below, above
+    new_hp[todo] = lo
+    dv = np.where(complies, 0.0, perigee_lowering_dv_m_s(hp, ha, new_hp))
+    return RuleCheck(
+        rule_years=float(rule_years),
+        lifetime_days=days,
+        reentered=reentered,
+        complies=complies,
+        new_perigee_m=new_hp,
+        dv_m_s=dv,
+    )

@@ -1,0 +1,203 @@
+"""A decay scenario: the atmosphere and the solar activity, shared by single lifetimes, batches and fits.
+
+SI units inside. A :class:`Scenario` turns the user's choice (the paper's law, an
+exponential law, or NRLMSIS under constant, tabulated or cyclic activity) into
+lifetimes of arrays of satellites through the fast paths: the universal curves of
+one fixed profile, or, when the activity changes over the lifetime (or the season
+is to be followed), the chunked curves of :mod:`orbit_env.propagate`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.atmosphere import Atmosphere, ExponentialAtmosphere, PaperAtmosphere
+from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.curves import UniversalCurves, universal_curves
+from orbit_env.decay import DecayModel
+from orbit_env.propagate import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, cached_curves, propagate
+from orbit_env.solar import ConstantActivity, CycleActivity, SolarActivity, TableActivity, iso_date
+
+FloatArray = NDArray[np.float64]
+AtmosphereKind = Literal["paper", "exponential", "msis"]
+ATMOSPHERES: tuple[str, ...] = ("paper", "exponential", "msis")
+
+
+@dataclass(frozen=True, eq=False)
+class Scenario:
+    """Which atmosphere and activity a decay runs in (everything but the satellite and its orbit).
+
+    Args:
+        atmosphere: ``paper``, ``exponential`` or ``msis``.
+        rho100_kg_m3: Paper law: density at 100 km (None: calibrated value).
+        density_scale: Multiplier on any model's density.
+        rho0_kg_m3: Exponential law: density at ``h0_m``.
+        h0_m: Exponential law: reference height.
+        scale_height_m: Exponential law: scale height.
+        activity: NRLMSIS: indices against time (default: F10.7 = 150, Ap = 15, constant).
+        epoch_days: Unix days of the orbit's epoch. With NRLMSIS it switches on the
+            time-stepped path, which follows the season and any change in activity.
+        rotating_atmosphere: Let the air co-rotate with the Earth.
+        ascending_node_local_time_h: NRLMSIS, Sun-synchronous orbits: local time of the node.
+        chunk_days: Time step of the time-stepped path.
+        max_years: The time-stepped path stops there (a satellite still up is reported so).
+    """
+
+    atmosphere: AtmosphereKind = "paper"
+    rho100_kg_m3: float | None = None
+    density_scale: float = 1.0
+    rho0_kg_m3: float = 1.3
+    h0_m: float = 0.0
+    scale_height_m: float = 8.5e3
+    activity: SolarActivity | None = None
+    epoch_days: float | None = None
+    rotating_atmosphere: bool = False
+    ascending_node_local_time_h: float | None = None
+    chunk_days: float = DEFAULT_CHUNK_DAYS
+    max_years: float = DEFAULT_MAX_YEARS
+
+    def __post_init__(self) -> None:
+        if self.atmosphere not in ATMOSPHERES:
+            raise ValueError(f"atmosphere must be one of {', '.join(ATMOSPHERES)}, got {self.atmosphere!r}")
+        if not (math.isfinite(self.density_scale) and self.density_scale > 0.0):
+            raise ValueError(f"density scale must be a positive finite number, got {self.density_scale!r}")
+        if self.atmosphere != "msis" and (self.activity is not None or self.epoch_days is not None):
+            raise ValueError("solar activity and epoch apply to the msis atmosphere only (use --atmosphere msis)")
+        if self.atmosphere != "paper" and self.rho100_kg_m3 is not None:
+            raise ValueError("rho100 applies to the paper atmosphere only")
+        if self.atmosphere == "msis" and self.epoch_days is None and self.activity is not None:
+            if not isinstance(self.activity, ConstantActivity):
+                raise ValueError("activity that changes with time needs an epoch (a start date)")
+
+    @property
+    def solar(self) -> SolarActivity:
+        """The activity (NRLMSIS default: constant F10.7 = 150 sfu, Ap = 15)."""
+        return self.activity if self.activity is not None else ConstantActivity(150.0, 150.0, 15.0)
+
+    @property
+    def time_varying(self) -> bool:
+        """True when lifetimes take the time-stepped path."""
+        return self.atmosphere == "msis" and self.epoch_days is not None
+
+    def fixed_atmosphere(self, inclination_deg: float) -> Atmosphere:
+        """The one density profile of a scenario that does not change in time (scale excluded)."""
+        if self.time_varying:
+            raise ValueError("this scenario changes in time; it has no single profile")
+        if self.atmosphere == "paper":
+            return PaperAtmosphere() if self.rho100_kg_m3 is None else PaperAtmosphere(self.rho100_kg_m3)
+        if self.atmosphere == "exponential":
+            return ExponentialAtmosphere(self.rho0_kg_m3, self.h0_m, self.scale_height_m)
+        from orbit_env.msis import MsisAtmosphere
+
+        solar = self.solar
+        assert isinstance(solar, ConstantActivity)
+        return MsisAtmosphere(
+            solar.f107_sfu,
+            solar.f107a_sfu,
+            solar.ap,
+            inclination_deg,
+            None,
+            self.ascending_node_local_time_h,
+        )
+
+    def decay_model(self, inclination_deg: float) -> DecayModel:
+        """The fixed-profile decay model (see :meth:`fixed_atmosphere`)."""
+        return DecayModel(self.fixed_atmosphere(inclination_deg), self.rotating_atmosphere, inclination_deg)
+
+    def curves(self, inclination_deg: float) -> UniversalCurves:
+        """The universal curves of the fixed profile (cached per profile)."""
+        model = self.decay_model(inclination_deg)
+        if self.atmosphere == "msis":
+            return cached_curves(model)  # the larger cache: batches may hold many inclinations
+        return universal_curves(model)
+
+    def solar_model(self, inclination_deg: float) -> SolarDecayModel:
+        """The time-stepped model (needs an epoch)."""
+        assert self.epoch_days is not None
+        return SolarDecayModel(
+            self.solar,
+            self.epoch_days,
+            inclination_deg,
+            follow_season=True,
+            rotating_atmosphere=self.rotating_atmosphere,
+            ascending_node_local_time_h=self.ascending_node_local_time_h,
+            chunk_days=self.chunk_days,
+            max_years=self.max_years,
+        )
+
+    def describe(self, inclination_deg: float) -> str:
+        """One line for the CLI."""
+        scale = f" x {self.density_scale:g}" if self.density_scale != 1.0 else ""
+        if self.atmosphere == "paper":
+            rho = self.fixed_atmosphere(inclination_deg)
+            assert isinstance(rho, PaperAtmosphere)
+            return f"paper, rho(100 km) = {rho.rho100_kg_m3:.4g} kg/m^3{scale}"
+        if self.atmosphere == "exponential":
+            return (
+                f"exponential, {self.rho0_kg_m3:.4g} kg/m^3 at {self.h0_m / 1e3:g} km, "
+                f"scale height {self.scale_height_m / 1e3:g} km{scale}"
+            )
+        solar = self.solar
+        if isinstance(solar, ConstantActivity):
+            what = f"F10.7 {solar.f107_sfu:g}, 81-day mean {solar.f107a_sfu:g} sfu, Ap {solar.ap:g}"
+        elif isinstance(solar, TableActivity):
+            what = f"solar table {solar.source} ({iso_date(solar.start_days)} to {iso_date(solar.end_days)})"
+        elif isinstance(solar, CycleActivity):
+            what = (
+                f"smooth solar cycle, F10.7 {solar.f107_min_sfu:g}-{solar.f107_max_sfu:g} sfu, "
+                f"minimum {iso_date(solar.minimum_days)}"
+            )
+        else:
+            what = type(solar).__name__
+        when = f", from {iso_date(self.epoch_days)} in {self.chunk_days:g}-day steps" if self.time_varying else ""
+        where = f"inclination {inclination_deg:g} deg"
+        if self.ascending_node_local_time_h is not None:
+            where += f", node at {self.ascending_node_local_time_h:g} h local time"
+        return f"NRLMSIS 2.1, {what}, {where}{when}{scale}"
+
+    def lifetime_days(
+        self,
+        perigee_m: ArrayLike,
+        apogee_m: ArrayLike,
+        drag_parameter_m2_kg: ArrayLike,
+        inclination_deg: float,
+        *,
+        density_scale: ArrayLike = 1.0,
+        max_days: float | None = None,
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """Days to re-entry of many satellites (one inclination), and whether they re-enter.
+
+        Fixed profiles: one lookup on the universal curves. Time-varying: the
+        chunked curves, stopped after ``max_days`` if given (else ``max_years``).
+
+        Raises:
+            ValueError: heights invalid or outside the universal curves' domain.
+        """
+        hp, ha = UniversalCurves.check_domain(perigee_m, apogee_m)
+        hp, ha, c, s = np.broadcast_arrays(
+            hp, ha, np.asarray(drag_parameter_m2_kg, dtype=np.float64), np.asarray(density_scale, dtype=np.float64)
+        )
+        s = s * self.density_scale
+        if not self.time_varying:
+            point = self.curves(inclination_deg).locate(hp, ha)
+            days = np.asarray(point.weighted_s / (G0_M_S2 * c * s) / SECONDS_PER_DAY, dtype=np.float64)
+            return days, np.ones(days.shape, dtype=bool)
+        model = self.solar_model(inclination_deg)
+        if max_days is not None:
+            model = SolarDecayModel(
+                model.activity,
+                model.start_days,
+                model.inclination_deg,
+                follow_season=model.follow_season,
+                rotating_atmosphere=model.rotating_atmosphere,
+                ascending_node_local_time_h=model.ascending_node_local_time_h,
+                chunk_days=model.chunk_days,
+                max_years=max(max_days / 365.25, model.chunk_days / 365.25),
+            )
+        result = propagate(hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel())
+        return result.days.reshape(hp.shape), result.reentered.reshape(hp.shape)

@@ -1,0 +1,297 @@
+"""Solar and geomagnetic activity over a satellite's life: F10.7, its 81-day mean, Ap.
+
+Time is counted in days since 1970-01-01 ("unix days", float); indices are in solar
+flux units (sfu = 1e-22 W m^-2 Hz^-1) and Ap in its own units. Three sources, all
+with the same vectorized method ``indices(unix_days) -> (f107, f107a, ap)``:
+
+* :class:`ConstantActivity`: fixed values.
+* :class:`TableActivity`: a user's table by date (:func:`read_solar_csv`), linearly
+  interpolated, the first/last row held outside it.
+* :class:`CycleActivity`: a smooth, periodic solar cycle with a phase, for
+  planning decades ahead when no forecast is at hand.
+
+The CSV format (``read_solar_csv``): a header row, then one row per date::
+
+    date,f107,f107a,ap
+    2013-10-01,132.0,125.3,9
+    2013-10-02,...
+
+``date`` is ``YYYY-MM-DD`` (or ``YYYY-MM``, read as the 15th). ``f107`` (observed
+daily F10.7, sfu) is required. ``f107a`` (81-day centred mean) is optional: without
+it, it is computed as the 81-day centred mean of the ``f107`` column (days outside
+the table take the nearest row). ``ap`` (daily Ap) is optional: without it the
+``default_ap`` given to the reader is used. Monthly rows work too (then ``f107`` is
+a monthly mean and the computed ``f107a`` a ~3-month mean).
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+#: Days in the 81-day centred mean of F10.7.
+F107A_WINDOW_DAYS = 81
+#: Default daily Ap where none is given (near the long-term median of daily Ap).
+DEFAULT_AP = 12.0
+#: Mean length of the solar cycle [days] (11.0 years).
+SOLAR_CYCLE_DAYS = 11.0 * 365.25
+
+
+def unix_days(date: str | _dt.date | np.datetime64) -> float:
+    """Days since 1970-01-01 of an ISO date (``YYYY-MM-DD``, ``YYYY-MM`` = the 15th, or with a time).
+
+    Raises:
+        ValueError: the date cannot be read.
+    """
+    text = str(date).strip()
+    try:
+        if len(text) == 7 and text[4] == "-":
+            value = np.datetime64(text + "-15", "s")
+        else:
+            value = np.datetime64(text, "s")
+    except ValueError as error:
+        raise ValueError(f"cannot read the date {text!r}; expected YYYY-MM-DD or YYYY-MM") from error
+    return float(value.astype(np.int64)) / 86400.0
+
+
+def iso_date(days: float) -> str:
+    """ISO date (``YYYY-MM-DD``) of a number of unix days."""
+    return str(np.datetime64(math.floor(days), "D"))
+
+
+def day_of_year(days: ArrayLike) -> FloatArray:
+    """Day of the year, 1 to 366 (fractional), of unix days."""
+    d = np.asarray(days, dtype=np.float64)
+    whole = np.floor(d).astype("int64").astype("datetime64[D]")
+    year_start = whole.astype("datetime64[Y]").astype("datetime64[D]")
+    return (whole - year_start).astype(np.float64) + 1.0 + (d - np.floor(d))
+
+
+@runtime_checkable
+class SolarActivity(Protocol):
+    """Anything that gives the indices at given times."""
+
+    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """F10.7 [sfu], its 81-day mean [sfu] and Ap at unix days (arrays of ``days``' shape)."""
+        ...
+
+
+def _check_index(name: str, value: float, low: float, high: float) -> float:
+    value = float(value)
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ValueError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class ConstantActivity:
+    """The same F10.7, 81-day mean and Ap at all times."""
+
+    f107_sfu: float
+    f107a_sfu: float
+    ap: float
+
+    def __post_init__(self) -> None:
+        _check_index("F10.7 (sfu)", self.f107_sfu, 40.0, 400.0)
+        _check_index("81-day mean F10.7 (sfu)", self.f107a_sfu, 40.0, 400.0)
+        _check_index("Ap", self.ap, 0.0, 400.0)
+
+    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The constant indices, broadcast to the shape of ``days``."""
+        shape = np.shape(days)
+        return np.full(shape, self.f107_sfu), np.full(shape, self.f107a_sfu), np.full(shape, self.ap)
+
+
+@dataclass(frozen=True, eq=False)
+class TableActivity:
+    """Indices by date, linearly interpolated; the first and last rows are held outside.
+
+    Attributes:
+        days: Unix days of the rows, strictly increasing.
+        f107_sfu: Daily (or monthly mean) F10.7.
+        f107a_sfu: 81-day centred mean of F10.7.
+        ap: Daily Ap.
+        source: Where the table came from (for messages).
+    """
+
+    days: FloatArray
+    f107_sfu: FloatArray
+    f107a_sfu: FloatArray
+    ap: FloatArray
+    source: str = field(default="table")
+
+    def __post_init__(self) -> None:
+        if self.days.size < 1:
+            raise ValueError(f"{self.source}: the solar table has no rows")
+        if np.any(np.diff(self.days) <= 0):
+            raise ValueError(f"{self.source}: dates must be strictly increasing")
+        for name, values, low, high in (
+            ("f107", self.f107_sfu, 40.0, 400.0),
+            ("f107a", self.f107a_sfu, 40.0, 400.0),
+            ("ap", self.ap, 0.0, 400.0),
+        ):
+            bad = ~(np.isfinite(values) & (values >= low) & (values <= high))
+            if bad.any():
+                row = int(np.argmax(bad))
+                date = iso_date(self.days[row])
+                raise ValueError(f"{self.source}: {name} on {date} is {values[row]!r}; allowed: {low:g} to {high:g}")
+
+    @property
+    def start_days(self) -> float:
+        """Unix day of the first row."""
+        return float(self.days[0])
+
+    @property
+    def end_days(self) -> float:
+        """Unix day of the last row."""
+        return float(self.days[-1])
+
+    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Indices interpolated at ``days`` (held at the edges)."""
+        t = np.asarray(days, dtype=np.float64)
+        return (
+            np.interp(t, self.days, self.f107_sfu),
+            np.interp(t, self.days, self.f107a_sfu),
+            np.interp(t, self.days, self.ap),
+        )
+
+
+def centred_mean(days: FloatArray, values: FloatArray, window_days: float = F107A_WINDOW_DAYS) -> FloatArray:
+    """Centred running mean over ``window_days`` of a series sampled at ``days`` (edges held)."""
+    half = 0.5 * window_days
+    grid = np.arange(np.floor(days[0] - half), np.ceil(days[-1] + half) + 1.0)
+    daily = np.interp(grid, days, values)
+    cumulative = np.concatenate([[0.0], np.cumsum(daily)])
+    # Mean of the daily values whose day lies in [t - half, t + half].
+    lo = np.clip(np.searchsorted(grid, days - half, side="left"), 0, grid.size)
+    hi = np.clip(np.searchsorted(grid, days + half, side="right"), 0, grid.size)
+    return (cumulative[hi] - cumulative[lo]) / np.maximum(hi - lo, 1)
+
+
+def read_solar_csv(path: str | Path, default_ap: float = DEFAULT_AP) -> TableActivity:
+    """Read a table of F10.7 (and optionally its 81-day mean and Ap) by date.
+
+    The format is in the module docstring.
+
+    Raises:
+        ValueError: a missing column, an unreadable number or date, dates out of
+            order, or indices out of range; the message names the file and row.
+        OSError: the file cannot be read.
+    """
+    source = str(path)
+    with open(path, newline="") as handle:
+        reader = csv.DictReader(handle)
+        columns = [name.strip().lower() for name in (reader.fieldnames or [])]
+        for required in ("date", "f107"):
+            if required not in columns:
+                raise ValueError(f"{source}: the solar table needs a '{required}' column, found {columns}")
+        rows = [{key.strip().lower(): (value or "").strip() for key, value in row.items() if key} for row in reader]
+    if not rows:
+        raise ValueError(f"{source}: the solar table has no rows")
+    days = np.empty(len(rows))
+    f107 = np.empty(len(rows))
+    f107a = np.full(len(rows), np.nan)
+    ap = np.full(len(rows), float(default_ap))
+    for i, row in enumerate(rows):
+        line = i + 2
+        try:
+            days[i] = unix_days(row["date"])
+            f107[i] = float(row["f107"])
+            if row.get("f107a"):
+                f107a[i] = float(row["f107a"])
+            if row.get("ap"):
+                ap[i] = float(row["ap"])
+        except ValueError as error:
+            raise ValueError(f"{source}, line {line}: {error}") from None
+    order_ok = np.all(np.diff(days) > 0)
+    if not order_ok:
+        raise ValueError(f"{source}: dates must be strictly increasing")
+    missing = np.isnan(f107a)
+    if missing.any():
+        f107a[missing] = centred_mean(days, f107)[missing]
+    return TableActivity(days, f107, f107a, ap, source=source)
+
+
+def _cycle_shape(phase: FloatArray, peak_phase: float) -> FloatArray:
+    """A smooth cycle on [0, 1): 0 at the minima, 1 at ``peak_phase``; zero slope at both ends.
+
+    sin^2(pi x^k) with x^k = 1/2 at the peak: rises faster than it falls, as solar
+    cycles do, and joins the next cycle with a continuous derivative.
+    """
+    k = math.log(0.5) / math.log(peak_phase)
+    return np.sin(np.pi * np.power(phase, k)) ** 2
+
+
+@dataclass(frozen=True)
+class CycleActivity:
+    """A smooth, periodic solar cycle (no forecast skill: a planning climatology).
+
+    F10.7 (daily and 81-day mean alike) runs from ``f107_min_sfu`` at each minimum
+    to ``f107_max_sfu`` at ``peak_phase`` of the cycle; Ap follows the same shape
+    between ``ap_min`` and ``ap_max``. The phase is set by a date of minimum.
+
+    Defaults: the minimum of December 2019 that began solar cycle 25 (as announced
+    by the NASA/NOAA Solar Cycle 25 Prediction Panel), an 11-year period, a peak
+    4.4 years after the minimum; F10.7 from 68 sfu (the 2008-09 and 2019 minima's
+    monthly means) to 150 sfu (a mid-sized cycle: cycle 24's smoothed maximum was
+    about 120-145 sfu, cycle 23's about 190 sfu); Ap from 6 to 15 (yearly means
+    near minimum and maximum).
+
+    Args:
+        minimum_days: Unix days of a solar minimum.
+        period_days: Cycle length.
+        peak_phase: Fraction of the cycle from the minimum to the maximum.
+        f107_min_sfu, f107_max_sfu: F10.7 at minimum and maximum.
+        ap_min, ap_max: Ap at minimum and maximum.
+    """
+
+    minimum_days: float = field(default_factory=lambda: unix_days("2019-12-15"))
+    period_days: float = SOLAR_CYCLE_DAYS
+    peak_phase: float = 0.4
+    f107_min_sfu: float = 68.0
+    f107_max_sfu: float = 150.0
+    ap_min: float = 6.0
+    ap_max: float = 15.0
+
+    def __post_init__(self) -> None:
+        _check_index("cycle length (days)", self.period_days, 365.0, 40 * 365.25)
+        _check_index("phase of the maximum", self.peak_phase, 0.1, 0.9)
+        _check_index("F10.7 at minimum (sfu)", self.f107_min_sfu, 40.0, 400.0)
+        _check_index("F10.7 at maximum (sfu)", self.f107_max_sfu, self.f107_min_sfu, 400.0)
+        _check_index("Ap at minimum", self.ap_min, 0.0, 400.0)
+        _check_index("Ap at maximum", self.ap_max, self.ap_min, 400.0)
+
+    @classmethod
+    def with_phase(cls, phase: float, at_days: float, **kwargs: float) -> CycleActivity:
+        """The cycle that is at ``phase`` (0 = minimum, ``peak_phase`` = maximum) on ``at_days``."""
+        phase = _check_index("cycle phase", phase, 0.0, 1.0)
+        period = float(kwargs.get("period_days", SOLAR_CYCLE_DAYS))
+        return cls(minimum_days=at_days - phase * period, **kwargs)
+
+    def phase(self, days: ArrayLike) -> FloatArray:
+        """Fraction of the cycle elapsed since the last minimum, in [0, 1)."""
+        return np.mod((np.asarray(days, dtype=np.float64) - self.minimum_days) / self.period_days, 1.0)
+
+    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Indices of the smooth cycle at ``days``."""
+        shape = _cycle_shape(self.phase(days), self.peak_phase)
+        f107 = self.f107_min_sfu + (self.f107_max_sfu - self.f107_min_sfu) * shape
+        return f107, f107.copy(), self.ap_min + (self.ap_max - self.ap_min) * shape
+
+
+def chunk_means(activity: SolarActivity, start_days: ArrayLike, length_days: float) -> tuple[FloatArray, ...]:
+    """Mean F10.7, 81-day mean and Ap over chunks [start, start + length), sampled daily."""
+    start = np.asarray(start_days, dtype=np.float64)
+    samples = max(1, math.ceil(length_days))
+    offsets = (np.arange(samples) + 0.5) * (length_days / samples)
+    f107, f107a, ap = activity.indices(start[..., None] + offsets)
+    return f107.mean(axis=-1), f107a.mean(axis=-1), ap.mean(axis=-1)
