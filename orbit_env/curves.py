@@ -32,6 +32,7 @@ orbits and prints the numbers in ``benchmarks/``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -74,19 +75,77 @@ def _eccentricity(perigee_m: float, apogee_m: float) -> float:
 
 
 def _bilinear(
-    table: FloatArray, x0: float, dx: float, y0: float, dy: float, x: FloatArray, y: FloatArray
-) -> FloatArray:
-    """Bilinear interpolation on a regular grid, clamped at its edges."""
-    nx, ny = table.shape
-    fx = np.clip((x - x0) / dx, 0.0, nx - 1.000001)
-    fy = np.clip((y - y0) / dy, 0.0, ny - 1.000001)
-    i = fx.astype(np.intp)
+    tables: FloatArray, x0: float, dx: float, y0: float, dy: float, x: FloatArray, y: FloatArray
+) -> list[FloatArray]:
+    """Bilinear interpolation of each of a stack of tables (k, nx, ny) on a regular grid, clamped at its edges.
+
+    The cell and the weights are found once for the whole stack and the corners
+    gathered with ``take`` on a flat index, in place where possible: on a batch of
+    thousands of orbits three times faster than 2-D fancy indexing table by table,
+    with the same arithmetic in the same order (so the same results, bit for bit).
+    """
+    _, nx, ny = tables.shape
+    fx = np.subtract(x, x0)
+    fx /= dx
+    fx = np.minimum(np.maximum(fx, 0.0), nx - 1.000001)
+    fy = np.subtract(y, y0)
+    fy /= dy
+    fy = np.minimum(np.maximum(fy, 0.0), ny - 1.000001)
+    k00 = fx.astype(np.intp)
+    tx = fx - k00
     j = fy.astype(np.intp)
+    ty = fy - j
+    sx = 1.0 - tx
+    sy = 1.0 - ty
+    k00 *= ny
+    k00 += j
+    k01 = k00 + 1
+    k10 = k00 + ny
+    k11 = k10 + 1
+    out = []
+    for table in tables:
+        flat = table.ravel()
+        low = flat.take(k00)
+        low *= sx
+        corner = flat.take(k10)
+        corner *= tx
+        low += corner
+        low *= sy
+        high = flat.take(k01)
+        high *= sx
+        corner = flat.take(k11)
+        corner *= tx
+        high += corner
+        high *= ty
+        low += high
+        out.append(low)
+    return out
+
+
+def _bilinear_scalar(
+    table: FloatArray, x0: float, dx: float, y0: float, dy: float, x: float, y: float
+) -> tuple[float, float, float]:
+    """:func:`_bilinear` for one point on the three stacked tables, in plain floats.
+
+    The single environment steps one orbit at a time, where numpy's per-call cost
+    on 0-d arrays is ten times the arithmetic. Same operations in the same order
+    as :func:`_bilinear`, so the results are identical.
+    """
+    _, nx, ny = table.shape
+    fx = min(max((x - x0) / dx, 0.0), nx - 1.000001)
+    fy = min(max((y - y0) / dy, 0.0), ny - 1.000001)
+    i = int(fx)
+    j = int(fy)
     tx = fx - i
     ty = fy - j
-    return (table[i, j] * (1.0 - tx) + table[i + 1, j] * tx) * (1.0 - ty) + (
-        table[i, j + 1] * (1.0 - tx) + table[i + 1, j + 1] * tx
-    ) * ty
+    sx = 1.0 - tx
+    sy = 1.0 - ty
+    item = table.item
+    return (
+        (item(0, i, j) * sx + item(0, i + 1, j) * tx) * sy + (item(0, i, j + 1) * sx + item(0, i + 1, j + 1) * tx) * ty,
+        (item(1, i, j) * sx + item(1, i + 1, j) * tx) * sy + (item(1, i, j + 1) * sx + item(1, i + 1, j + 1) * tx) * ty,
+        (item(2, i, j) * sx + item(2, i + 1, j) * tx) * sy + (item(2, i, j + 1) * sx + item(2, i + 1, j + 1) * tx) * ty,
+    )
 
 
 @dataclass(frozen=True)
@@ -106,6 +165,8 @@ class CurvePoint:
     @property
     def nu(self) -> FloatArray:
         """Universal lifetime left, nu [m^3/(kg s^2)]."""
+        if isinstance(self.tau, float):
+            return NU_REF * math.expm1(self.tau)
         return NU_REF * np.expm1(self.tau)
 
     @property
@@ -123,6 +184,12 @@ class UniversalCurves:
     The curves are integrated backward from re-entry, one every 0.1 in the label
     mu = ln(e at re-entry), from e = 1e-9 (circular to the top of the domain) to
     the orbit with a 5000 km apogee at re-entry.
+
+    Python floats in, Python floats out: for ``float`` arguments ``locate``, ``at``
+    and ``advance`` take a scalar path with the same arithmetic as the array path
+    (results equal to 1e-12 relative; only ``math`` versus numpy ``exp``/``log``
+    may differ in the last bit). It exists for the single environment, which
+    steps one orbit at a time.
     """
 
     def __init__(self, model: DecayModel) -> None:
@@ -138,6 +205,7 @@ class UniversalCurves:
         q[:, 0] = period_weight_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
         self._table_a = self._build_table_a(hp, y, tau, q)
         self._table_b = self._build_table_b(hp, y, q)
+        self._label0 = float(self.labels[0])
 
     def _slope(self, hp: FloatArray, y: FloatArray, dnu_dtau: float | FloatArray) -> FloatArray:
         """d/dtau of perigee height, ln(e) and W, backward from re-entry, one curve each."""
@@ -247,39 +315,67 @@ class UniversalCurves:
 
     def locate(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> CurvePoint:
         """Place orbits on the curves (heights must be valid and in the domain)."""
+        if isinstance(perigee_m, float) and isinstance(apogee_m, float):
+            hp_m = float(perigee_m)
+            y_s = math.log(max(_eccentricity(hp_m, float(apogee_m)), E_FLOOR))
+            a0, a1, a2 = _bilinear_scalar(self._table_a, REENTRY_ALTITUDE_M, _DH_M, self._label0, _DY, hp_m, y_s)
+            return CurvePoint(label=y_s + a0, tau=max(a1, 0.0), mean_period_s=a2)
         hp = np.asarray(perigee_m, dtype=np.float64)
         _, e = elements_from_heights(hp, apogee_m)
         y = np.log(np.maximum(e, E_FLOOR))
         # Table A holds mu - ln(e), exact for orbits below its lowest row (translates).
-        args = (REENTRY_ALTITUDE_M, _DH_M, float(self.labels[0]), _DY, hp, y)
-        table = self._table_a
-        return CurvePoint(
-            label=y + _bilinear(table[0], *args),
-            tau=np.maximum(_bilinear(table[1], *args), 0.0),
-            mean_period_s=_bilinear(table[2], *args),
-        )
+        a0, a1, a2 = _bilinear(self._table_a, REENTRY_ALTITUDE_M, _DH_M, self._label0, _DY, hp, y)
+        return CurvePoint(label=y + a0, tau=np.maximum(a1, 0.0), mean_period_s=a2)
 
     def at(self, label: ArrayLike, tau: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Perigee height [m], apogee height [m] and mean period left [s] at (label, tau)."""
+        if isinstance(label, float) and isinstance(tau, float):
+            mu_s = float(label)
+            b0, b1, b2 = _bilinear_scalar(self._table_b, self._label0, _LABEL_SPACING, 0.0, _DTAU, mu_s, float(tau))
+            hp_s = max(b0, REENTRY_ALTITUDE_M)
+            e_s = math.exp(b1 + mu_s)
+            rp_s = EARTH_RADIUS_M + hp_s
+            return hp_s, rp_s * (1.0 + e_s) / (1.0 - e_s) - EARTH_RADIUS_M, b2
         mu = np.asarray(label, dtype=np.float64)
-        t = np.asarray(tau, dtype=np.float64)
-        args = (float(self.labels[0]), _LABEL_SPACING, 0.0, _DTAU, mu, t)
-        table = self._table_b
-        hp = np.maximum(_bilinear(table[0], *args), REENTRY_ALTITUDE_M)
-        e = np.exp(_bilinear(table[1], *args) + mu)
+        b0, b1, b2 = _bilinear(self._table_b, self._label0, _LABEL_SPACING, 0.0, _DTAU, mu, np.asarray(tau, np.float64))
+        hp = np.maximum(b0, REENTRY_ALTITUDE_M)
+        e = np.exp(b1 + mu)
         rp = EARTH_RADIUS_M + hp
-        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, _bilinear(table[2], *args)
+        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, b2
+
+    def _tau_after(self, point: CurvePoint, dnu: ArrayLike) -> FloatArray:
+        """The tau reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
+        if isinstance(point.tau, float) and isinstance(dnu, float):
+            return math.log1p(max(point.nu - dnu, 0.0) / NU_REF)
+        return np.log1p(np.maximum(point.nu - np.asarray(dnu, dtype=np.float64), 0.0) / NU_REF)
 
     def advance(self, point: CurvePoint, dnu: ArrayLike) -> CurvePoint:
         """Move along the curves by ``dnu`` of the universal variable (clamped at re-entry)."""
-        nu = np.maximum(point.nu - np.asarray(dnu, dtype=np.float64), 0.0)
-        tau = np.log1p(nu / NU_REF)
-        _, _, q = self.at(point.label, tau)
-        return CurvePoint(label=np.asarray(point.label, dtype=np.float64), tau=tau, mean_period_s=q)
+        tau = self._tau_after(point, dnu)
+        if isinstance(tau, float) and isinstance(point.label, float):
+            label_s = float(point.label)
+            return CurvePoint(label=label_s, tau=tau, mean_period_s=self.at(label_s, tau)[2])
+        label = np.asarray(point.label, dtype=np.float64)
+        # Only the mean period: the third table of at().
+        (q,) = _bilinear(self._table_b[2:], self._label0, _LABEL_SPACING, 0.0, _DTAU, label, tau)
+        return CurvePoint(label=label, tau=tau, mean_period_s=q)
+
+    def advance_heights(self, point: CurvePoint, dnu: ArrayLike) -> tuple[CurvePoint, FloatArray, FloatArray]:
+        """:meth:`advance`, and the perigee and apogee heights [m] of the new point.
+
+        The same as ``advance`` followed by ``at``, in one interpolation: what a
+        simulator stepping many orbits and observing their heights needs.
+        """
+        tau = self._tau_after(point, dnu)
+        label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
+        perigee_m, apogee_m, q = self.at(label, tau)
+        return CurvePoint(label=label, tau=tau, mean_period_s=q), perigee_m, apogee_m
 
 
 def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0) -> FloatArray:
     """Universal variable one revolution is worth: dnu/dN = g c s (Eq. 4.1)."""
+    if isinstance(drag_parameter_m2_kg, float) and isinstance(density_scale, float):
+        return G0_M_S2 * float(drag_parameter_m2_kg) * float(density_scale)
     return G0_M_S2 * np.asarray(drag_parameter_m2_kg, dtype=np.float64) * np.asarray(density_scale, dtype=np.float64)
 
 
