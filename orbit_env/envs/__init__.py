@@ -1,0 +1,54 @@
+"""Gymnasium environments: perigee burns against drag, registered in one place.
+
+| id                          | actions                     | density                           |
+|-----------------------------|-----------------------------|-----------------------------------|
+| ``OrbitRaising-v0``         | Discrete: burn sizes        | the paper's, known                |
+| ``OrbitRaisingContinuous-v0``| Box [-1, 1]: burn size     | the paper's, known                |
+| ``OrbitRaisingUncertain-v0``| Discrete: burn sizes        | scale drawn per episode, hidden   |
+
+Each has a single environment (``gymnasium.make``) and a numpy-batched vector
+environment (``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``).
+"""
+
+from __future__ import annotations
+
+import gymnasium
+
+from orbit_env.envs.orbit_raising import (
+    DEFAULT_HORIZON_STEPS,
+    UNCERTAIN_DENSITY,
+    DensityConfig,
+    OrbitRaisingConfig,
+    OrbitRaisingEnv,
+)
+
+__all__ = ["ENV_IDS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv", "register_envs"]
+
+_ENTRY_POINT = "orbit_env.envs.orbit_raising:OrbitRaisingEnv"
+_VECTOR_ENTRY_POINT = "orbit_env.envs.vector:OrbitRaisingVectorEnv"
+
+#: Every registered id and the keyword arguments that make the variant.
+_VARIANTS: dict[str, dict[str, object]] = {
+    "OrbitRaising-v0": {},
+    "OrbitRaisingContinuous-v0": {"continuous": True},
+    "OrbitRaisingUncertain-v0": {"density": UNCERTAIN_DENSITY},
+}
+ENV_IDS = tuple(_VARIANTS)
+
+
+def register_envs() -> None:
+    """Register the orbit-raising environments with Gymnasium (safe to call twice).
+
+    Truncation of the single environment is the registered ``max_episode_steps``
+    (``DEFAULT_HORIZON_STEPS``); the vector environment owns its own.
+    """
+    for env_id, kwargs in _VARIANTS.items():
+        if env_id in gymnasium.registry:
+            continue
+        gymnasium.register(
+            id=env_id,
+            entry_point=_ENTRY_POINT,
+            vector_entry_point=_VECTOR_ENTRY_POINT,
+            max_episode_steps=DEFAULT_HORIZON_STEPS,
+            kwargs=dict(kwargs),
+        )

@@ -1,0 +1,366 @@
+"""The orbit-raising environment batched over many satellites with numpy, SI units.
+
+The same pure functions as the single environment (:mod:`orbit_env.envs.orbit_raising`)
+called on arrays of shape (num_envs,): one call of the universal curves moves every
+satellite. The vector environment owns truncation (``horizon_steps``) and resets
+finished satellites in the same step (``AutoresetMode.SAME_STEP``): the step returns
+the first observation of the new episode, and ``info["final_obs"]`` the last one of
+the old (the convention of Stable-Baselines3, see :mod:`orbit_env.envs.sb3`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+from numpy.typing import NDArray
+
+from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
+from orbit_env.envs.orbit_raising import (
+    DensityConfig,
+    OrbitRaisingConfig,
+    action_space,
+    coast,
+    delta_v_left_m_s,
+    density_scale_at,
+    observation,
+    observation_space,
+    perigee_burn,
+    resolve_options,
+    sample_start,
+)
+
+FloatArray = NDArray[np.float64]
+
+
+class OrbitRaisingVectorEnv(VectorEnv):
+    """``num_envs`` independent orbit-raising missions stepped together with numpy.
+
+    Observation, action, reward and episode end are those of
+    :class:`orbit_env.envs.orbit_raising.OrbitRaisingEnv` (read its docstring),
+    batched: observations (num_envs, 7) float32, rewards float64, actions of shape
+    (num_envs,) (discrete) or (num_envs, 1) (continuous). Truncation after
+    ``config.horizon_steps`` steps. Finished missions restart in the same step
+    (``metadata["autoreset_mode"]`` is ``SAME_STEP``); their last observation is
+    in ``info["final_obs"]`` (masked by ``info["_final_obs"]``).
+
+    ``reset(options=...)`` takes the single environment's options, each a number
+    or an array of shape (num_envs,); they pin only that reset, not the automatic
+    ones. All randomness is drawn from ``self.np_random``, one stream for the
+    batch: sub-environment i is not the single environment seeded with seed + i.
+
+    Args:
+        num_envs: Number of satellites.
+        config: Satellite and task (default ``OrbitRaisingConfig()``).
+        continuous: Continuous burn size instead of the discrete burns.
+        density: Density knowledge (default: the paper's atmosphere, known).
+        max_episode_steps: Passed by ``gymnasium.make_vec`` from the registration;
+            must equal ``config.horizon_steps`` (the observation's clock runs on it).
+        render_mode: Only None: render a single environment instead.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": [], "autoreset_mode": AutoresetMode.SAME_STEP}
+
+    #: Per-satellite state arrays, all of shape (num_envs,).
+    _STATE = (
+        "_label",
+        "_tau",
+        "_period",
+        "_perigee_m",
+        "_apogee_m",
+        "_mass_kg",
+        "_dry_mass_kg",
+        "_exhaust_m_s",
+        "_drag_area_m2",
+        "_density_base",
+        "_density_phase",
+        "_density_scale",
+        "_nu_per_rev",
+        "_nominal_w_per_day",
+        "_dv_left_m_s",
+        "_time_days",
+        "_steps",
+    )
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        config: OrbitRaisingConfig | None = None,
+        *,
+        continuous: bool = False,
+        density: DensityConfig | None = None,
+        max_episode_steps: int | None = None,
+        render_mode: str | None = None,
+    ) -> None:
+        if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
+            raise ValueError(f"num_envs={num_envs!r} is invalid; allowed: an integer >= 1")
+        self.config = OrbitRaisingConfig() if config is None else config
+        self.density = DensityConfig() if density is None else density
+        if not isinstance(self.config, OrbitRaisingConfig):
+            raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig")
+        if not isinstance(self.density, DensityConfig):
+            raise ValueError(f"density={density!r} is invalid; allowed: a DensityConfig")
+        if max_episode_steps is not None and max_episode_steps != self.config.horizon_steps:
+            raise ValueError(
+                f"max_episode_steps={max_episode_steps} but config.horizon_steps={self.config.horizon_steps}; "
+                "pass max_episode_steps=config.horizon_steps to gymnasium.make_vec"
+            )
+        if render_mode is not None:
+            raise ValueError(f"render_mode={render_mode!r} is invalid; the vector environment does not render")
+        self.num_envs = int(num_envs)
+        self.continuous = bool(continuous)
+        self.render_mode = None
+        self.single_observation_space = observation_space()
+        self.single_action_space = action_space(self.config, self.continuous)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._burn_sizes = np.array(self.config.burn_sizes_m_s, dtype=np.float64)
+        self._curves = universal_curves()
+        n = self.num_envs
+        zeros = np.zeros(n)
+        # Curve coordinates (label, tau, mean period), heights and the satellites.
+        self._label, self._tau, self._period = zeros.copy(), zeros.copy(), zeros.copy()
+        self._perigee_m, self._apogee_m = zeros.copy(), zeros.copy()
+        self._mass_kg, self._dry_mass_kg, self._exhaust_m_s = zeros.copy(), zeros.copy(), zeros.copy()
+        self._drag_area_m2, self._density_base, self._density_phase = zeros.copy(), zeros.copy(), zeros.copy()
+        # _nominal_w_per_day: g c s0 x 1 day, with the nominal density: W / it is the predicted lifetime [days].
+        self._nu_per_rev, self._nominal_w_per_day, self._dv_left_m_s = zeros.copy(), zeros.copy(), zeros.copy()
+        self._time_days, self._density_scale = zeros.copy(), zeros.copy()
+        self._steps = np.zeros(n, dtype=np.int64)
+        self._has_state = False
+        self._all_true = np.ones(n, dtype=np.bool_)
+        self._pool: dict[str, Any] = {}
+        self._pool_next = n
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_curves"] = None
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._curves = universal_curves()
+
+    @property
+    def state(self) -> dict[str, FloatArray]:
+        """The simulator state of every satellite (copies), as :attr:`OrbitRaisingEnv.state`."""
+        return {
+            "label": self._label.copy(),
+            "tau": self._tau.copy(),
+            "perigee_m": self._perigee_m.copy(),
+            "apogee_m": self._apogee_m.copy(),
+            "mass_kg": self._mass_kg.copy(),
+            "time_days": self._time_days.copy(),
+            "density_scale": self._density_scale.copy(),
+        }
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[NDArray[np.float32], dict[str, Any]]:
+        """Start new missions in every sub-environment (options as the single env's, per env)."""
+        super().reset(seed=seed)
+        everyone = np.arange(self.num_envs)
+        self._start(everyone, options)
+        self._has_state = True
+        self._pool_next = self.num_envs  # empty: the next restart draws a fresh pool
+        zeros = np.zeros(self.num_envs)
+        return self._observe_subset(everyone, zeros, zeros), {}
+
+    def step(
+        self, actions: Any
+    ) -> tuple[NDArray[np.float32], FloatArray, NDArray[np.bool_], NDArray[np.bool_], dict[str, Any]]:
+        """Burn where asked, coast every satellite one block, restart the finished ones."""
+        if not self._has_state:
+            raise RuntimeError("call reset() before step()")
+        requested = self._requested_dv(actions)
+        dv = np.zeros(self.num_envs)
+        burning = np.flatnonzero((requested > 0.0) & (self._mass_kg > self._dry_mass_kg))
+        if burning.size:
+            burning = self._burn(burning, requested[burning], dv)
+        if self.density.varies:
+            self._update_rates(np.arange(self.num_envs))
+        perigee_m, apogee_m = self._perigee_m, self._apogee_m
+        after, self._perigee_m, self._apogee_m, days, weighted_s = coast(
+            self._curves,
+            CurvePoint(self._label, self._tau, self._period),
+            self.config.revolutions_per_step,
+            self._nu_per_rev,
+        )
+        self._tau, self._period = after.tau, after.mean_period_s
+        self._time_days += days
+        self._steps += 1
+        obs = self._observe(weighted_s, perigee_m - self._perigee_m, apogee_m - self._apogee_m)
+        reward = days
+        if burning.size:
+            reward[burning] -= self.config.propellant_cost_per_m_s * dv[burning]
+        terminated = self._tau <= 0.0
+        truncated = self._steps >= self.config.horizon_steps
+        truncated &= ~terminated
+        infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._all_true}
+        done = terminated | truncated
+        if done.any():
+            finished = np.flatnonzero(done)
+            final_obs = np.empty(self.num_envs, dtype=object)
+            for i, row in zip(finished.tolist(), obs[finished], strict=True):
+                final_obs[i] = row
+            infos["final_obs"] = final_obs
+            infos["_final_obs"] = done
+            infos["final_info"] = {}
+            infos["_final_info"] = done
+            obs[finished] = self._restart(finished)
+        return obs, reward, terminated, truncated, infos
+
+    def _requested_dv(self, actions: Any) -> FloatArray:
+        """Requested burns [m/s]; ValueError for actions outside the batched action space."""
+        n = self.num_envs
+        a = np.asarray(actions)
+        if not self.continuous:
+            if a.shape != (n,) or a.dtype.kind not in "iu":
+                raise ValueError(
+                    f"actions of shape {a.shape} and dtype {a.dtype} are invalid; allowed: integers of shape ({n},)"
+                )
+            if a.min() < 0 or a.max() >= self._burn_sizes.size:
+                bad = (a < 0) | (a >= self._burn_sizes.size)
+                raise ValueError(
+                    f"action {a[bad][0].item()!r} is invalid; allowed: integers in [0, {self._burn_sizes.size - 1}]"
+                )
+            return self._burn_sizes.take(a)
+        if a.shape not in ((n, 1), (n,)):
+            raise ValueError(f"actions of shape {a.shape} are invalid; allowed: shape ({n}, 1)")
+        a = a.reshape(n).astype(np.float64)
+        bad = ~(np.abs(a) <= 1.0)
+        if bad.any():
+            raise ValueError(f"action {a[bad][0].item()!r} is invalid; allowed: numbers in [-1, 1]")
+        return self.config.max_burn_m_s * np.maximum(a, 0.0)
+
+    def _burn(self, idx: NDArray[np.intp], requested: FloatArray, dv_out: FloatArray) -> NDArray[np.intp]:
+        """Burn for sub-environments ``idx``; write the burns into ``dv_out``, return who fired."""
+        dv, apogee_m, mass_kg = perigee_burn(
+            self._perigee_m[idx],
+            self._apogee_m[idx],
+            self._mass_kg[idx],
+            self._dry_mass_kg[idx],
+            self._exhaust_m_s[idx],
+            requested,
+        )
+        fired = dv > 0.0
+        if not fired.all():
+            idx, dv, apogee_m, mass_kg = idx[fired], dv[fired], apogee_m[fired], mass_kg[fired]
+        if idx.size:
+            dv_out[idx] = dv
+            self._mass_kg[idx] = mass_kg
+            self._update_satellite(idx)
+            self._set_point(idx, self._curves.locate(self._perigee_m[idx], apogee_m))
+        return idx
+
+    def _start(self, idx: NDArray[np.intp], options: dict[str, Any] | None) -> None:
+        """Draw (or pin) new missions for sub-environments ``idx``."""
+        drawn = sample_start(self.np_random, self.config, self.density, idx.size)
+        start = resolve_options(options, drawn, self.config, size=idx.size)
+        self._dry_mass_kg[idx] = start["dry_mass_kg"]
+        self._mass_kg[idx] = self._dry_mass_kg[idx] + start["propellant_mass_kg"]
+        self._exhaust_m_s[idx] = np.asarray(start["isp_s"]) * G0_M_S2
+        self._drag_area_m2[idx] = np.asarray(start["drag_coefficient"]) * np.asarray(start["area_m2"])
+        self._density_base[idx] = start["density_scale"]
+        self._density_phase[idx] = start["density_phase_rad"]
+        self._time_days[idx] = 0.0
+        self._steps[idx] = 0
+        self._update_satellite(idx)
+        perigee_m = np.broadcast_to(np.asarray(start["perigee_km"]) * 1e3, idx.shape)
+        apogee_m = np.broadcast_to(np.asarray(start["apogee_km"]) * 1e3, idx.shape)
+        self._set_point(idx, self._curves.locate(perigee_m, apogee_m))
+
+    def _restart(self, idx: NDArray[np.intp]) -> NDArray[np.float32]:
+        """Automatic reset of ``idx``: copy fresh missions from the pool; return their observations.
+
+        A few dozen satellites finish per step out of thousands. Drawing and
+        locating them one step at a time costs more in numpy's per-call overhead
+        than the whole batch's step, so fresh missions are drawn ``num_envs`` at a
+        time into a pool (with the same functions as ``reset``) and handed out in order.
+        """
+        if self._pool_next + idx.size > self.num_envs:
+            self._fill_pool()
+        take = slice(self._pool_next, self._pool_next + idx.size)
+        self._pool_next += idx.size
+        for name, array in self._pool.items():
+            getattr(self, name)[idx] = array[take]
+        zeros = np.zeros(idx.size)
+        return self._observe_subset(idx, zeros, zeros)
+
+    def _fill_pool(self) -> None:
+        """Draw ``num_envs`` fresh missions into the pool (the state arrays of a restart)."""
+        saved = {name: getattr(self, name).copy() for name in self._STATE}
+        everyone = np.arange(self.num_envs)
+        self._start(everyone, None)
+        self._pool = {name: getattr(self, name).copy() for name in self._STATE}
+        for name, array in saved.items():
+            setattr(self, name, array)
+        self._pool_next = 0
+
+    def _update_satellite(self, idx: NDArray[np.intp]) -> None:
+        """Recompute what depends on the mass for ``idx``: delta-v left and g c s."""
+        mass = self._mass_kg[idx]
+        self._dv_left_m_s[idx] = np.maximum(delta_v_left_m_s(mass, self._dry_mass_kg[idx], self._exhaust_m_s[idx]), 0.0)
+        nominal = nu_per_revolution(self._drag_area_m2[idx] / mass, self.density.nominal_scale)
+        self._nominal_w_per_day[idx] = nominal * SECONDS_PER_DAY
+        self._update_rates(idx)
+
+    def _density_now(self, idx: NDArray[np.intp] | slice) -> FloatArray:
+        base = self._density_base[idx]
+        if not self.density.varies:
+            return base.copy()
+        return density_scale_at(
+            base,
+            self.density.cycle_amplitude,
+            self.density.cycle_period_days,
+            self._density_phase[idx],
+            self._time_days[idx],
+        )
+
+    def _update_rates(self, idx: NDArray[np.intp]) -> None:
+        """Set g c s per revolution of ``idx``, s the density scale now (held over the coming step)."""
+        scale = self._density_now(idx)
+        self._density_scale[idx] = scale
+        self._nu_per_rev[idx] = nu_per_revolution(self._drag_area_m2[idx] / self._mass_kg[idx], scale)
+
+    def _set_point(self, idx: NDArray[np.intp], point: CurvePoint) -> None:
+        """Take freshly located orbits; heights and mean period from ``at`` (see the single env's)."""
+        self._label[idx] = point.label
+        self._tau[idx] = point.tau
+        perigee_m, apogee_m, period_s = self._curves.at(point.label, point.tau)
+        self._period[idx] = period_s
+        self._perigee_m[idx] = perigee_m
+        self._apogee_m[idx] = apogee_m
+
+    def _observe(
+        self, weighted_s: FloatArray, perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
+    ) -> NDArray[np.float32]:
+        """Observations of every sub-environment, given W = Int P dnu left [s m^3/(kg s^2)]."""
+        columns = observation(
+            self._perigee_m,
+            self._apogee_m,
+            self._dv_left_m_s,
+            self._steps / self.config.horizon_steps,
+            weighted_s / self._nominal_w_per_day,
+            apogee_drop_m,
+            perigee_drop_m,
+        )
+        return np.stack(columns, axis=1, dtype=np.float32, casting="same_kind")
+
+    def _observe_subset(
+        self, idx: NDArray[np.intp], perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
+    ) -> NDArray[np.float32]:
+        weighted_s = CurvePoint(self._label[idx], self._tau[idx], self._period[idx]).weighted_s
+        columns = observation(
+            self._perigee_m[idx],
+            self._apogee_m[idx],
+            self._dv_left_m_s[idx],
+            self._steps[idx] / self.config.horizon_steps,
+            weighted_s / self._nominal_w_per_day[idx],
+            apogee_drop_m,
+            perigee_drop_m,
+        )
+        return np.stack(columns, axis=1, dtype=np.float32, casting="same_kind")
