@@ -1,0 +1,303 @@
+"""The density scale factor from an observed decay: the paper's proposal at the end of section 4.
+
+SI units inside (m, s); observation files and results at the edge in km and days.
+
+The paper notes that the lifetime is nearly inversely proportional to the density
+near the initial perigee, so an observed decay measures the real density. Here the
+measured quantity is a factor s on the chosen model's density (any atmosphere of a
+:class:`orbit_env.scenario.Scenario`). On a fixed profile s enters the decay only
+through time: t = W / (g c s) (``orbit_env.decay``), so the decay follows the
+universal curves and s sets how fast.
+
+Two kinds of data:
+
+* **Observed orbits** (three or more rows of time, perigee, apogee). Parameters: ln s
+  and the first orbit's perigee and apogee (the first row is as noisy as the rest).
+  The model orbit at time t_i is found on the curves: W falls by g c s (t_i - t_0)
+  from the first orbit's W, solved for nu by Newton's method (dW/dnu = P).
+  Nonlinear least squares on the height residuals, unweighted; the noise sigma is
+  estimated from the residuals (RSS / (2n - 3)) and the covariance is
+  sigma^2 (J^T J)^-1. Intervals use Student's t with 2n - 3 degrees of freedom.
+  Needs a fixed profile (not a time-stepped NRLMSIS scenario).
+* **A re-entry date** (the first row and ``reentry``): s = W_0 / (g c dt) on a
+  fixed profile, or, under changing activity, the s whose time-stepped lifetime is
+  dt (found by bracketing on a vectorized grid of s, then interpolation in ln s).
+  The uncertainty is propagated linearly from the re-entry time's
+  (``reentry_sigma_days``) and the first orbit's heights' (``height_sigma_km``,
+  both heights, independent); the model's own error is not included.
+
+Observation CSV: a header, then rows with ``date`` (``YYYY-MM-DD``, optionally with
+``THH:MM``) or ``days`` (days from any origin), ``perigee_km`` and ``apogee_km``,
+in time order.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import optimize, stats
+
+from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.curves import NU_REF, UniversalCurves
+from orbit_env.orbit import elements_from_heights, period_s
+from orbit_env.scenario import Scenario
+from orbit_env.solar import unix_days
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Observations:
+    """Observed orbits: time [days from any origin], perigee and apogee heights [km]."""
+
+    days: FloatArray
+    perigee_km: FloatArray
+    apogee_km: FloatArray
+    source: str = "observations"
+
+
+def read_observations(path: str | Path) -> Observations:
+    """Read observed orbits (format in the module docstring).
+
+    Raises:
+        ValueError: missing columns, unreadable values, times not increasing.
+    """
+    source = str(path)
+    with open(path, newline="") as handle:
+        reader = csv.DictReader(handle)
+        header = [name.strip().lower() for name in reader.fieldnames or []]
+        rows = [{(k or "").strip().lower(): (v or "").strip() for k, v in row.items()} for row in reader]
+    for required in ("perigee_km", "apogee_km"):
+        if required not in header:
+            raise ValueError(f"{source}: the observations need a '{required}' column, found {header}")
+    if "date" not in header and "days" not in header:
+        raise ValueError(f"{source}: the observations need a 'date' or a 'days' column, found {header}")
+    if not rows:
+        raise ValueError(f"{source}: no observations")
+    days, hp, ha = (np.empty(len(rows)) for _ in range(3))
+    for i, row in enumerate(rows):
+        try:
+            days[i] = unix_days(row["date"]) if row.get("date") else float(row["days"])
+            hp[i], ha[i] = float(row["perigee_km"]), float(row["apogee_km"])
+        except (ValueError, KeyError) as error:
+            raise ValueError(f"{source}, line {i + 2}: {error}") from None
+    if np.any(np.diff(days) <= 0):
+        raise ValueError(f"{source}: observation times must be strictly increasing")
+    return Observations(days, hp, ha, source)
+
+
+@dataclass(frozen=True)
+class DensityFit:
+    """A fitted density scale factor.
+
+    Attributes:
+        scale: Best estimate of s (multiplies the model's density).
+        sigma_log: Standard error of ln s.
+        dof: Degrees of freedom of the noise estimate (None: known sigmas, normal intervals).
+        description: What was fitted.
+        residual_rms_km: RMS height residual of an orbit fit.
+    """
+
+    scale: float
+    sigma_log: float
+    dof: int | None
+    description: str
+    residual_rms_km: float | None = None
+
+    def interval(self, level: float = 0.68) -> tuple[float, float]:
+        """Central interval of s at probability ``level`` (symmetric in ln s)."""
+        tail = 0.5 + 0.5 * level
+        quantile = float(stats.norm.ppf(tail) if self.dof is None else stats.t.ppf(tail, self.dof))
+        return self.scale * math.exp(-quantile * self.sigma_log), self.scale * math.exp(quantile * self.sigma_log)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        low68, high68 = self.interval(0.68)
+        low95, high95 = self.interval(0.95)
+        return {
+            "scale": self.scale,
+            "sigma_log": self.sigma_log,
+            "interval68": [low68, high68],
+            "interval95": [low95, high95],
+            "residual_rms_km": self.residual_rms_km,
+            "description": self.description,
+        }
+
+
+def orbits_after(
+    curves: UniversalCurves, perigee_m: float, apogee_m: float, weight_drop: ArrayLike
+) -> tuple[FloatArray, FloatArray]:
+    """Perigee and apogee [m] after W has fallen by ``weight_drop`` [s m^3/(kg s^2)] from an orbit.
+
+    W = Int P dnu along the orbit's curve; dW/dnu = P, so Newton's method in nu
+    converges in a few steps. Past re-entry the re-entry orbit is returned.
+    """
+    point = curves.locate(np.array([perigee_m]), np.array([apogee_m]))
+    label0, nu0 = point.label[0], float(point.nu[0])
+    hp0, ha0, q0 = curves.at(point.label, point.tau)
+    w0 = float(q0[0]) * nu0
+    drop = np.asarray(weight_drop, dtype=np.float64)
+    target = np.maximum(w0 - drop, 0.0)
+    label = np.full(drop.shape, label0)
+    nu = np.maximum(nu0 - drop / float(period_s(*elements_from_heights(hp0, ha0))[0]), 0.0)
+    for _ in range(4):
+        hp, ha, q = curves.at(label, np.log1p(nu / NU_REF))
+        nu = np.maximum(nu - (q * nu - target) / period_s(*elements_from_heights(hp, ha)), 0.0)
+    hp, ha, _ = curves.at(label, np.log1p(nu / NU_REF))
+    return hp, ha
+
+
+def fit_density_scale(
+    observations: Observations,
+    *,
+    satellite: Any,
+    scenario: Scenario,
+    inclination_deg: float = 0.0,
+    reentry: str | float | None = None,
+    reentry_sigma_days: float = 0.5,
+    height_sigma_km: float = 1.0,
+) -> DensityFit:
+    """Estimate the density scale factor s of ``scenario`` from an observed decay.
+
+    Args:
+        observations: Observed orbits (the first is the start).
+        satellite: A :class:`orbit_env.api.Satellite` (its drag parameter is used).
+        scenario: Atmosphere and activity whose density is scaled.
+        inclination_deg: Orbit inclination.
+        reentry: Observed re-entry (date, or days on the observations' time axis):
+            fit from the first orbit and the lifetime.
+        reentry_sigma_days: Uncertainty of the re-entry time (reentry fits).
+        height_sigma_km: Uncertainty of the first orbit's heights (reentry fits).
+
+    Raises:
+        ValueError: too few observations, a re-entry before the first orbit, heights
+            outside the curves, or an orbit fit on a time-varying scenario.
+    """
+    c = satellite.drag_parameter_m2_kg
+    hp = observations.perigee_km * 1e3
+    ha = observations.apogee_km * 1e3
+    UniversalCurves.check_domain(hp, ha)
+    if reentry is not None:
+        t_reentry = unix_days(reentry) if isinstance(reentry, str) else float(reentry)
+        dt_days = t_reentry - float(observations.days[0])
+        if not dt_days > 0:
+            raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
+        for name, value in (("reentry_sigma_days", reentry_sigma_days), ("height_sigma_km", height_sigma_km)):
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ValueError(f"{name} must be a non-negative number, got {value!r}")
+        return _fit_reentry(
+            float(hp[0]), float(ha[0]), dt_days, c, scenario, inclination_deg, reentry_sigma_days, height_sigma_km
+        )
+    if scenario.time_varying:
+        raise ValueError(
+            "fitting observed orbits needs a fixed profile (no --epoch, --solar-csv or --solar-cycle); "
+            "with changing activity give the re-entry date (--reentry)"
+        )
+    n = hp.size
+    if n < 3:
+        raise ValueError(f"an orbit fit needs at least 3 observations, got {n} (or give --reentry)")
+    curves = scenario.curves(inclination_deg)
+    gc_dt = G0_M_S2 * c * scenario.density_scale * (observations.days - observations.days[0]) * SECONDS_PER_DAY
+    observed = np.concatenate([hp, ha]) / 1e3
+
+    def predicted_km(theta: FloatArray) -> FloatArray:
+        log_s, hp0_km, ha0_km = theta
+        hp0 = max(hp0_km, 100.0 + 1e-3) * 1e3
+        ha0 = max(ha0_km, hp0_km) * 1e3
+        p_hp, p_ha = orbits_after(curves, hp0, ha0, gc_dt * math.exp(log_s))
+        return np.concatenate([p_hp, p_ha]) / 1e3
+
+    start = _initial_log_scale(curves, hp, ha, gc_dt)
+    solution = optimize.least_squares(
+        lambda theta: predicted_km(theta) - observed,
+        x0=np.array([start, hp[0] / 1e3, ha[0] / 1e3]),
+        x_scale=np.array([0.1, 1.0, 1.0]),
+        diff_step=1e-5,
+    )
+    dof = 2 * n - 3
+    residuals = solution.fun
+    sigma2 = float(residuals @ residuals) / dof
+    jac = solution.jac
+    covariance = sigma2 * np.linalg.pinv(jac.T @ jac)
+    return DensityFit(
+        scale=float(math.exp(solution.x[0])),
+        sigma_log=float(math.sqrt(max(covariance[0, 0], 0.0))),
+        dof=dof,
+        description=f"{n} orbits over {observations.days[-1] - observations.days[0]:.4g} days ({observations.source})",
+        residual_rms_km=float(math.sqrt(float(residuals @ residuals) / residuals.size)),
+    )
+
+
+def _initial_log_scale(curves: UniversalCurves, hp: FloatArray, ha: FloatArray, gc_dt: FloatArray) -> float:
+    """Return ln s from the first and last orbits' W difference (a starting point for the fit)."""
+    points = curves.locate(hp[[0, -1]], ha[[0, -1]])
+    drop = float(points.weighted_s[0] - points.weighted_s[1])
+    if drop <= 0 or gc_dt[-1] <= 0:
+        return 0.0
+    return math.log(drop / float(gc_dt[-1]))
+
+
+def _fit_reentry(
+    hp_m: float,
+    ha_m: float,
+    dt_days: float,
+    c: float,
+    scenario: Scenario,
+    inclination_deg: float,
+    sigma_t_days: float,
+    sigma_h_km: float,
+) -> DensityFit:
+    def log_scale(hp: float, ha: float, dt: float) -> float:
+        if not scenario.time_varying:
+            w0 = float(scenario.curves(inclination_deg).locate(np.array([hp]), np.array([ha])).weighted_s[0])
+            return math.log(w0 / (G0_M_S2 * c * scenario.density_scale * dt * SECONDS_PER_DAY))
+        return _log_scale_time_varying(hp, ha, dt, c, scenario, inclination_deg)
+
+    best = log_scale(hp_m, ha_m, dt_days)
+    step_h = max(sigma_h_km, 0.5) * 1e3
+    d_hp = (log_scale(hp_m + step_h, max(ha_m, hp_m + step_h), dt_days) - best) / step_h
+    d_ha = (log_scale(hp_m, ha_m + step_h, dt_days) - best) / step_h
+    variance = (sigma_t_days / dt_days) ** 2 + (d_hp**2 + d_ha**2) * (sigma_h_km * 1e3) ** 2
+    return DensityFit(
+        scale=math.exp(best),
+        sigma_log=math.sqrt(variance),
+        dof=None,
+        description=f"re-entry {dt_days:.4g} days after a {hp_m / 1e3:g} x {ha_m / 1e3:g} km orbit",
+    )
+
+
+def _log_scale_time_varying(
+    hp: float, ha: float, dt_days: float, c: float, scenario: Scenario, inclination_deg: float
+) -> float:
+    """Return ln s whose time-stepped lifetime equals ``dt_days`` (lifetime falls monotonically with s)."""
+    lo, hi = math.log(0.05), math.log(20.0)
+    for _ in range(3):
+        grid = np.linspace(lo, hi, 17)
+        days, reentered = scenario.lifetime_days(
+            np.full(grid.size, hp),
+            np.full(grid.size, ha),
+            np.full(grid.size, c),
+            inclination_deg,
+            density_scale=np.exp(grid),
+            max_days=4.0 * dt_days + 60.0,
+        )
+        days = np.where(reentered, days, np.inf)
+        short = days <= dt_days
+        if not short.any() or short.all():
+            raise ValueError(
+                f"no density scale between 0.05 and 20 gives a lifetime of {dt_days:.4g} days for this orbit"
+            )
+        k = int(np.argmax(short))  # first (smallest s) with a lifetime <= dt
+        lo, hi = grid[k - 1], grid[k]
+        d_lo, d_hi = days[k - 1], days[k]
+    # Lifetime ~ 1/s locally: interpolate ln(days) linearly in ln s.
+    if np.isfinite(d_lo):
+        w = (math.log(d_lo) - math.log(dt_days)) / (math.log(d_lo) - math.log(d_hi))
+        return float(lo + w * (hi - lo))
+    return float(hi)

@@ -1,0 +1,164 @@
+"""The modern CLI: atmospheres, batch CSV files, the disposal rule; and poliastro's drag test."""
+
+import csv
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+from orbit_env.api import Satellite, lifetime
+from orbit_env.atmosphere import ExponentialAtmosphere
+from orbit_env.cli import main
+
+
+def run(capsys, *argv):
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_poliastro_drag_test_48_2_days():
+    # poliastro's test_atmospheric_demise: 230 km circular, C_D 2.2, A = pi/4 m^2, m = 100 kg,
+    # rho = 1.3 exp(-h / 8.5 km) kg/m^3, re-enters at 48.2 days. The issue asks for 2%; we are
+    # within 0.3% (the difference: our sphere of 6371 km against poliastro's 6378 km and its
+    # re-entry criterion, and our orbit average).
+    satellite = Satellite(2.2, 100.0, math.pi / 4)
+    atmosphere = ExponentialAtmosphere(1.3, 0.0, 8.5e3)
+    for method in ("averaged", "curves"):
+        result = lifetime(230, 230, satellite=satellite, atmosphere=atmosphere, method=method)
+        assert result.days == pytest.approx(48.2, rel=0.02)
+
+
+def test_cli_exponential_matches_the_api(capsys):
+    argv = ["lifetime", "--perigee", "230", "--apogee", "230", "--atmosphere", "exponential", "--cx", "2.2"]
+    status, out, _ = run(capsys, *argv, "--mass", "100", "--area", str(math.pi / 4), "--json")
+    assert status == 0
+    assert json.loads(out)["days"] == pytest.approx(48.2, rel=0.02)
+    status, out, _ = run(capsys, *argv, "--mass", "100", "--area", "0.785", "--rho0", "1.3", "--scale-height-km", "17")
+    assert status == 0 and "scale height 17 km" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--f107", "100"], "--f107 applies to --atmosphere msis"),
+        (["--atmosphere", "msis", "--rho0", "1"], "--rho0 applies to --atmosphere exponential"),
+        (["--atmosphere", "msis", "--solar-cycle"], "--solar-cycle needs --epoch"),
+        (["--atmosphere", "msis", "--cycle-phase", "0.3"], "--cycle-phase applies to --solar-cycle"),
+        (["--atmosphere", "msis", "--f107", "10"], "F10.7"),
+        (["--atmosphere", "msis", "--epoch", "2024-13-01"], "cannot read the date"),
+        (["--out", "x.csv"], "--out goes with --batch"),
+    ],
+)
+def test_cli_errors_are_one_line(capsys, argv, message):
+    status, _, err = run(capsys, "lifetime", "--perigee", "400", "--apogee", "400", *argv)
+    assert status == 2
+    assert message in err and err.count("\n") == 1
+
+
+def test_cli_msis_constant_and_rule(capsys):
+    pytest.importorskip("pymsis")
+    base = ["lifetime", "--perigee", "500", "--apogee", "500", "--atmosphere", "msis", "--inclination", "51.6"]
+    sat = ["--cx", "2.2", "--mass", "4", "--area", "0.03"]
+    status, out, _ = run(
+        capsys, *base, *sat, "--f107", "150", "--ap", "15", "--rule", "1", "--method", "curves", "--json"
+    )
+    result = json.loads(out)
+    assert status == 0 and result["days"] > 365.25 and not result["complies"]
+    assert result["dv_m_s"] > 0 and 100 < result["new_perigee_km"] < 500
+    after = lifetime(
+        result["new_perigee_km"],
+        500,
+        satellite=Satellite(2.2, 4.0, 0.03),
+        atmosphere=__import__("orbit_env.msis", fromlist=["MsisAtmosphere"]).MsisAtmosphere(150, 150, 15, 51.6),
+        method="curves",
+    )
+    assert after.days <= 365.25
+    # More solar activity, shorter life.
+    _, out_high, _ = run(capsys, *base, *sat, "--f107", "250", "--method", "curves", "--json")
+    assert json.loads(out_high)["days"] < 0.6 * result["days"]
+
+
+def test_cli_solar_csv(capsys, tmp_path):
+    pytest.importorskip("pymsis")
+    flux = tmp_path / "flux.csv"
+    rows = [f"2024-{m:02d},{160 + 5 * (m % 3)}" for m in range(1, 13)] + ["2025-01,150"]
+    flux.write_text("date,f107\n" + "\n".join(rows) + "\n")
+    status, out, _ = run(
+        capsys, "lifetime", "--perigee", "300", "--apogee", "300", "--atmosphere", "msis", "--solar-csv", str(flux),
+        "--inclination", "51.6", "--cx", "2.2", "--mass", "100", "--area", "1", "--method", "curves",
+    )  # fmt: skip
+    assert status == 0
+    assert "solar table" in out and "from 2024-01-15 in 20-day steps" in out
+
+
+def write_catalogue(path, n, seed=0):
+    rng = np.random.default_rng(seed)
+    hp = rng.uniform(200, 900, n)
+    ha = hp + rng.exponential(200, n)
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["name", "perigee_km", "apogee_km", "mass_kg", "area_m2", "cx"])
+        for i in range(n):
+            writer.writerow([f"sat{i}", f"{hp[i]:.3f}", f"{ha[i]:.3f}", "100", f"{rng.uniform(0.5, 2):.3f}", "2.2"])
+    return hp, ha
+
+
+def test_batch_matches_single_lifetimes_and_reports_bad_rows(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    with open(sats, "w") as handle:
+        handle.write("name,perigee_km,apogee_km,mass_kg,area_m2,mass_per_area_kg_m2\n")
+        handle.write("a,300,500,100,1,\n")
+        handle.write("b,400,400,,,50\n")
+        handle.write("c,500,450,100,1,\n")  # apogee below perigee
+        handle.write("d,1200,1300,100,1,\n")  # outside the curves
+        handle.write("e,abc,300,100,1,\n")
+        handle.write("f,350,360,,,\n")  # the CLI's satellite
+    out = tmp_path / "out.csv"
+    status, stdout, _ = run(capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress", "--cx", "2.2")
+    assert status == 0 and "6 rows" in stdout and "3 with lifetimes" in stdout
+    records = list(csv.DictReader(open(out)))
+    assert [r["name"] for r in records] == ["a", "b", "c", "d", "e", "f"]
+    expected = {
+        "a": lifetime(300, 500, satellite=Satellite(2.2, 100, 1), method="curves").days,
+        "b": lifetime(400, 400, satellite=Satellite.from_mass_per_area(50, 2.2), method="curves").days,
+        "f": lifetime(350, 360, satellite=Satellite(2.2), method="curves").days,
+    }
+    for record in records:
+        if record["name"] in expected:
+            assert record["status"] == "ok"
+            assert float(record["days"]) == pytest.approx(expected[record["name"]], rel=1e-5)
+        else:
+            assert record["status"] != "ok" and record["days"] == ""
+    assert "below the perigee" in records[2]["status"]
+    assert "outside the universal curves" in records[3]["status"]
+    assert "line 6" in records[4]["status"]
+
+
+def test_batch_rule_columns(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_text("perigee_km,apogee_km,mass_kg,area_m2\n800,800,100,1\n500,500,100,1\n")
+    out = tmp_path / "out.csv"
+    status, _, _ = run(
+        capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--rule", "25", "--cx", "2.2", "--no-progress"
+    )
+    assert status == 0
+    first, second = csv.DictReader(open(out))
+    assert first["complies"] == "false" and float(first["dv_m_s"]) == pytest.approx(55.6, abs=0.5)
+    assert second["complies"] == "true" and float(second["dv_m_s"]) == 0.0
+
+
+def test_batch_of_100k_through_the_curves(capsys, tmp_path):
+    sats, out = tmp_path / "sats.csv", tmp_path / "out.csv"
+    write_catalogue(sats, 100_000)
+    start = time.perf_counter()
+    status, stdout, _ = run(capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress")
+    elapsed = time.perf_counter() - start
+    assert status == 0 and "100000 rows" in stdout
+    # Not a speed test (benchmarks measure speed): a guard that the batch stays on the vectorized
+    # path (a per-row loop through the averaged ODE would take hours).
+    assert elapsed < 60
+    with open(out) as handle:
+        assert sum(1 for _ in handle) == 100_001
