@@ -92,8 +92,9 @@ def main() -> None:
     parser.add_argument("--plot", help="write predicted against observed to this PNG")
     args = parser.parse_args()
     activity = solar_activity()
-    header = f"{'case':8} {'observed d':>10} {'c_x 2.2':>9} {'err':>7} {'band (h convention)':>22} {'+skin fr.':>9} {'err':>7}"
-    print(header)
+    columns = ("observed d", "c_x 2.2", "err", "band (h convention)", "+skin fr.", "err")
+    widths = (10, 9, 7, 22, 9, 7)
+    print(f"{'case':8} " + " ".join(f"{name:>{width}}" for name, width in zip(columns, widths, strict=True)))
     rows = []
     for case in CASES:
         observed = unix_days(case.reentry) - unix_days(case.epoch)
