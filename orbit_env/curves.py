@@ -91,14 +91,14 @@ def _bilinear(
     fy = np.subtract(y, y0)
     fy /= dy
     fy = np.minimum(np.maximum(fy, 0.0), ny - 1.000001)
-    k00 = fx.astype(np.intp)
-    tx = fx - k00
+    i = fx.astype(np.intp)
+    tx = fx - i
     j = fy.astype(np.intp)
     ty = fy - j
     sx = 1.0 - tx
     sy = 1.0 - ty
-    k00 *= ny
-    k00 += j
+    # Not in place: x and y may broadcast against each other (a grid of queries).
+    k00 = i * ny + j
     k01 = k00 + 1
     k10 = k00 + ny
     k11 = k10 + 1
