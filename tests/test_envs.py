@@ -32,6 +32,7 @@ from gymnasium.utils.env_checker import check_env
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import orbit_env
 from orbit_env import curves as curves_module
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
@@ -293,6 +294,13 @@ def test_a_satellite_that_never_burns_lives_as_long_as_the_curves_say(perigee_km
     assert days == pytest.approx(located.weighted_s / nu_per_rev / SECONDS_PER_DAY, rel=0.005)
     reference = integrate_averaged(perigee_km * 1e3, apogee_km * 1e3)
     assert days == pytest.approx(reference.weighted_s[-1] / nu_per_rev / SECONDS_PER_DAY, rel=0.005)
+    # ... and as the package's lifetime API says for the same satellite (its full mass: no burn).
+    satellite = orbit_env.Satellite(config.drag_coefficient, config.wet_mass_kg, config.area_m2)
+    for method in ("curves", "averaged"):
+        result = orbit_env.lifetime(
+            perigee_km, apogee_km, satellite=satellite, method=method, density_scale=density_scale
+        )
+        assert days == pytest.approx(result.days, rel=0.005), method
     # The step of re-entry counts only the part of the block before re-entry.
     full_block_days = config.revolutions_per_step * 87.0 * 60.0 / SECONDS_PER_DAY  # 87 min: the shortest period
     assert 0.0 <= last < full_block_days
@@ -593,8 +601,8 @@ def test_render_modes():
 def test_missing_matplotlib_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     env = OrbitRaisingEnv(render_mode="rgb_array")
+    env.reset(seed=0)  # rgb_array draws on demand only: no matplotlib needed until render()
     with pytest.raises(ImportError, match=r"pip install 'orbit-env\[plot\]'"):
-        env.reset(seed=0)  # rgb_array renders on demand only; reset does not draw ...
         env.render()
 
 
@@ -705,8 +713,11 @@ def test_batched_interpolation_is_the_plain_formula_bit_for_bit():
         x = rng.uniform(-5.0, nx + 5.0, 5000) * 2.0 + 1.0
         y = rng.uniform(-5.0, ny + 5.0, 5000) * 0.5 - 3.0
         fast = curves_module._bilinear(tables, 1.0, 2.0, -3.0, 0.5, x, y)
+        grid = curves_module._bilinear(tables, 1.0, 2.0, -3.0, 0.5, x[:40, None], y[None, :30])  # broadcasting
         for row in range(3):
             np.testing.assert_array_equal(fast[row], plain_bilinear(tables[row], 1.0, 2.0, -3.0, 0.5, x, y))
+            plain_grid = plain_bilinear(tables[row], 1.0, 2.0, -3.0, 0.5, x[:40, None], y[None, :30])
+            np.testing.assert_array_equal(grid[row], plain_grid)
 
 
 def test_vector_env_uses_the_curves_not_a_copy(monkeypatch):

@@ -92,9 +92,10 @@ def _finite_positive(name: str, value: Any) -> None:
 class DensityConfig:
     """How well the environment's agent knows the upper-air density.
 
-    The paper's Table 1 atmosphere times a scale s. The paper stresses that the
-    density above 200 km was uncertain by orders of magnitude in 1957, and its
-    lifetimes scale as 1/s (section 4). Per episode, s0 is drawn log-uniform in
+    The paper's Table 1 atmosphere times a scale s. The paper notes (section 1)
+    that published upper-air densities differed by 1.5-2.5 orders of magnitude,
+    and that the lifetime is about inversely proportional to the density near
+    the perigee (section 4). Per episode, s0 is drawn log-uniform in
     ``scale_range``; during the episode s(t) = s0 exp(A sin(2 pi t / T + phi)),
     a solar-cycle-like factor with random phase phi, held constant over each step.
 
@@ -110,7 +111,7 @@ class DensityConfig:
     cycle_period_days: float = 4018.0
 
     def __post_init__(self) -> None:
-        low_high = tuple(self.scale_range)
+        low_high = tuple(self.scale_range) if isinstance(self.scale_range, (tuple, list)) else ()
         _check(
             "scale_range",
             self.scale_range,
@@ -139,9 +140,9 @@ class DensityConfig:
         return self.cycle_amplitude > 0.0
 
 
-#: The density of ``OrbitRaisingUncertain-v0``: s0 log-uniform over two orders of
-#: magnitude either side of the paper's atmosphere (0.1 to 10), and a solar-cycle
-#: factor of e^{+-0.5}: over a one-year mission it drifts by up to 25%.
+#: The density of ``OrbitRaisingUncertain-v0``: s0 log-uniform over the two orders
+#: of magnitude of the paper's section 1 (0.1 to 10 times its atmosphere), and a
+#: solar-cycle factor of e^{+-0.5}: over a one-year mission it drifts by up to 30%.
 UNCERTAIN_DENSITY = DensityConfig(scale_range=(0.1, 10.0), cycle_amplitude=0.5)
 
 
@@ -160,7 +161,7 @@ class OrbitRaisingConfig:
             paper's example sphere).
         dry_mass_kg: Mass without propellant [kg] (40 kg).
         propellant_mass_kg: Propellant at the start [kg] (6 kg: with the Isp below
-            300 m/s, enough to raise the apogee of a 250 km perigee by about 1000 km).
+            300 m/s, enough to take a 250 km circular orbit to 250 x 1380 km).
         isp_s: Specific impulse [s] (220 s, a hydrazine monopropellant thruster).
         burn_sizes_m_s: Delta-v of each discrete action [m/s] (0, 10, 30, 100):
             coast, a trim (about +35 km of apogee), a medium burn (+100 km) and
@@ -510,8 +511,9 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
     the paper's universal curves (Fig. 2) at the rate dnu/dN = g c s per revolution
     (Eq. 4.1), c = c_x F / m. Each step is a block of K revolutions. At the start of
     a step the agent may fire its engine at perigee: the tangential burn keeps the
-    perigee and raises the apogee (exact vis-viva), the cheap way to a long life
-    of the paper's section 4 (360 x 700 km -> 360 x 1000 km: 78 m/s, lifetime x2.2).
+    perigee and raises the apogee (exact vis-viva), the paper's cheap way to a long
+    life (section 4: 360 x 700 km -> 360 x 1000 km costs 78 m/s and multiplies the
+    lifetime by 2.2).
     The propellant is finite and the burn spends mass by the rocket equation, which
     raises c and so shortens the life per unit nu. A satellite that never burns
     lives exactly as long as the curves say.
@@ -544,8 +546,10 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
     time, its own prediction of the lifetime from the paper's tables, and the decay
     it has observed. With the default, known density the prediction is exact; in
     ``OrbitRaisingUncertain-v0`` the true density scale is not observed and only
-    the observed decay (5, 6) against the prediction (4) reveals it. Tables give
-    mins the env can reach; the Box is [0, high] everywhere.
+    the observed decay (5, 6) against the prediction (4) reveals it. "Min" is the
+    least value the env produces; the Box's low is 0 for every component. The
+    clock is held at 1 past ``horizon_steps``. ``info["burn_m_s"]`` is the burn
+    made, and ``env.unwrapped.state`` the simulator's state (for tests and plots).
 
     ## Rewards
 

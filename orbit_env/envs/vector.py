@@ -131,8 +131,8 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._time_days, self._density_scale = zeros.copy(), zeros.copy()
         self._steps = np.zeros(n, dtype=np.int64)
         self._has_state = False
-        self._all_true = np.ones(n, dtype=np.bool_)
         self._pool: dict[str, Any] = {}
+        self._pool_obs = np.zeros((0, 7), dtype=np.float32)
         self._pool_next = n
 
     def __getstate__(self) -> dict[str, Any]:
@@ -197,9 +197,9 @@ class OrbitRaisingVectorEnv(VectorEnv):
         if burning.size:
             reward[burning] -= self.config.propellant_cost_per_m_s * dv[burning]
         terminated = self._tau <= 0.0
+        # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         truncated = self._steps >= self.config.horizon_steps
-        truncated &= ~terminated
-        infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._all_true}
+        infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": np.ones(self.num_envs, dtype=np.bool_)}
         done = terminated | truncated
         if done.any():
             finished = np.flatnonzero(done)
@@ -287,8 +287,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._pool_next += idx.size
         for name, array in self._pool.items():
             getattr(self, name)[idx] = array[take]
-        zeros = np.zeros(idx.size)
-        return self._observe_subset(idx, zeros, zeros)
+        return self._pool_obs[take]
 
     def _fill_pool(self) -> None:
         """Draw ``num_envs`` fresh missions into the pool (the state arrays of a restart)."""
@@ -296,6 +295,8 @@ class OrbitRaisingVectorEnv(VectorEnv):
         everyone = np.arange(self.num_envs)
         self._start(everyone, None)
         self._pool = {name: getattr(self, name).copy() for name in self._STATE}
+        zeros = np.zeros(self.num_envs)
+        self._pool_obs = self._observe_subset(everyone, zeros, zeros)
         for name, array in saved.items():
             setattr(self, name, array)
         self._pool_next = 0
@@ -339,28 +340,42 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self, weighted_s: FloatArray, perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
     ) -> NDArray[np.float32]:
         """Observations of every sub-environment, given W = Int P dnu left [s m^3/(kg s^2)]."""
-        columns = observation(
-            self._perigee_m,
-            self._apogee_m,
-            self._dv_left_m_s,
-            self._steps / self.config.horizon_steps,
-            weighted_s / self._nominal_w_per_day,
-            apogee_drop_m,
-            perigee_drop_m,
+        return _stack(
+            observation(
+                self._perigee_m,
+                self._apogee_m,
+                self._dv_left_m_s,
+                self._steps / self.config.horizon_steps,
+                weighted_s / self._nominal_w_per_day,
+                apogee_drop_m,
+                perigee_drop_m,
+            )
         )
-        return np.stack(columns, axis=1, dtype=np.float32, casting="same_kind")
 
     def _observe_subset(
         self, idx: NDArray[np.intp], perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
     ) -> NDArray[np.float32]:
         weighted_s = CurvePoint(self._label[idx], self._tau[idx], self._period[idx]).weighted_s
-        columns = observation(
-            self._perigee_m[idx],
-            self._apogee_m[idx],
-            self._dv_left_m_s[idx],
-            self._steps[idx] / self.config.horizon_steps,
-            weighted_s / self._nominal_w_per_day[idx],
-            apogee_drop_m,
-            perigee_drop_m,
+        return _stack(
+            observation(
+                self._perigee_m[idx],
+                self._apogee_m[idx],
+                self._dv_left_m_s[idx],
+                self._steps[idx] / self.config.horizon_steps,
+                weighted_s / self._nominal_w_per_day[idx],
+                apogee_drop_m,
+                perigee_drop_m,
+            )
         )
-        return np.stack(columns, axis=1, dtype=np.float32, casting="same_kind")
+
+
+def _stack(columns: tuple[FloatArray, ...]) -> NDArray[np.float32]:
+    """Columns into a (n, 7) float32 observation, stored column-major.
+
+    Filling rows of a (7, n) buffer and returning its transpose is three times
+    faster than a row-major stack; ``CartPoleVectorEnv`` returns the same layout.
+    """
+    out = np.empty((len(columns), np.size(columns[0])), dtype=np.float32)
+    for row, column in zip(out, columns, strict=True):
+        row[...] = column
+    return out.T
