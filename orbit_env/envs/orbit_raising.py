@@ -334,10 +334,17 @@ def perigee_burn(
     Returns:
         (dv [m/s], apogee after the burn [m], mass after the burn [kg]).
     """
-    dv_cap = perigee_velocity_m_s(perigee_m, CURVES_MAX_APOGEE_M) - perigee_velocity_m_s(perigee_m, apogee_m)
     dv_fuel = delta_v_left_m_s(mass_kg, dry_mass_kg, exhaust_velocity_m_s)
-    dv = np.maximum(np.minimum(np.minimum(requested_dv_m_s, dv_fuel), dv_cap), 0.0)
-    apogee_after = np.minimum(apogee_after_perigee_burn_m(perigee_m, apogee_m, dv), CURVES_MAX_APOGEE_M)
+    dv = np.maximum(np.minimum(requested_dv_m_s, dv_fuel), 0.0)
+    apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
+    # Beyond the cap, or hyperbolic (a negative apogee): burn only up to the cap. Rare,
+    # so the cap's burn is computed only when some burn needs it.
+    over = ~((apogee_after >= apogee_m) & (apogee_after <= CURVES_MAX_APOGEE_M))
+    if np.any(over):
+        dv_cap = perigee_velocity_m_s(perigee_m, CURVES_MAX_APOGEE_M) - perigee_velocity_m_s(perigee_m, apogee_m)
+        dv = np.where(over, np.maximum(np.minimum(dv, dv_cap), 0.0), dv)
+        apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
+    apogee_after = np.minimum(apogee_after, CURVES_MAX_APOGEE_M)
     mass_after = np.asarray(mass_kg) * np.exp(-dv / np.asarray(exhaust_velocity_m_s))
     # Emptying the tank leaves exactly the dry mass (the exponential rounds either way).
     mass_after = np.where(dv >= dv_fuel, dry_mass_kg, np.maximum(mass_after, dry_mass_kg))
