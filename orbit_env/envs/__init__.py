@@ -1,13 +1,15 @@
 """Gymnasium environments: perigee burns against drag, registered in one place.
 
-| id                          | actions                     | density                           |
-|-----------------------------|-----------------------------|-----------------------------------|
-| ``OrbitRaising-v0``         | Discrete: burn sizes        | the paper's, known                |
-| ``OrbitRaisingContinuous-v0``| Box [-1, 1]: burn size     | the paper's, known                |
-| ``OrbitRaisingUncertain-v0``| Discrete: burn sizes        | scale drawn per episode, hidden   |
+| id                            | actions                | density                                   |
+|-------------------------------|------------------------|-------------------------------------------|
+| ``OrbitRaising-v0``           | Discrete: burn sizes   | the paper's, known                        |
+| ``OrbitRaisingContinuous-v0`` | Box [-1, 1]: burn size | the paper's, known                        |
+| ``OrbitRaisingUncertain-v0``  | Discrete: burn sizes   | scale drawn per episode, hidden, drifting |
 
 Each has a single environment (``gymnasium.make``) and a numpy-batched vector
-environment (``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``).
+environment (``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``);
+:mod:`orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
+is the docstring of :class:`OrbitRaisingEnv`.
 """
 
 from __future__ import annotations

@@ -588,7 +588,10 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
     ## Arguments
 
     ``gymnasium.make("OrbitRaising-v0", config=OrbitRaisingConfig(...),
-    continuous=False, density=DensityConfig(...), render_mode=None)``.
+    continuous=False, density=DensityConfig(...), render_mode=None)``; the same
+    keywords for ``gymnasium.make_vec(id, num_envs=N,
+    vectorization_mode="vector_entry_point")``, the numpy-batched version
+    (:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`).
     ``render_mode``: "human" and "rgb_array" draw the (apogee, perigee) plane of
     the paper's Fig. 2 with the track and the burns (needs ``orbit-env[plot]``);
     "ansi" returns one line of text.
