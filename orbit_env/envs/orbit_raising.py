@@ -663,7 +663,6 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         self._revolutions = float(self.config.revolutions_per_step)
         self._cost = float(self.config.propellant_cost_per_m_s)
         self._horizon = int(self.config.horizon_steps)
-        self._curves = universal_curves()
         self._point: CurvePoint | None = None
         self._perigee_m = 0.0
         self._apogee_m = 0.0
@@ -673,17 +672,13 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         self._ep = _Episode()
         self._renderer: Any = None
 
-    # Pickling: the curves are a cached table (~10 MB) shared by every env in the
-    # process; send the state, rebuild the reference.
+    # The universal curves are not an attribute: universal_curves() is the process's
+    # one cached table, so a pickled env carries only its own state. Neither does it
+    # carry its figure, which is drawn again on the next render().
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
-        state["_curves"] = None
         state["_renderer"] = None
         return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        self._curves = universal_curves()
 
     @property
     def state(self) -> dict[str, float]:
@@ -719,7 +714,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         self._time_days = 0.0
         self._steps = 0
         self._update_satellite()
-        self._set_point(self._curves.locate(float(start["perigee_km"]) * 1e3, float(start["apogee_km"]) * 1e3))
+        self._set_point(universal_curves().locate(float(start["perigee_km"]) * 1e3, float(start["apogee_km"]) * 1e3))
         self._last_obs = self._observe(self._point.weighted_s, 0.0, 0.0)
         if self.render_mode is not None:
             ep.track.append((self._perigee_m, self._apogee_m, 0.0))
@@ -742,7 +737,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         start = self._point
         perigee_m, apogee_m = self._perigee_m, self._apogee_m
         after, self._perigee_m, self._apogee_m, days, weighted_s = coast(
-            self._curves, start, self._revolutions, ep.nu_per_rev
+            universal_curves(), start, self._revolutions, ep.nu_per_rev
         )
         self._point = after
         self._time_days += days
@@ -788,7 +783,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         if dv > 0.0:
             ep.mass_kg = float(mass_kg)
             self._update_satellite()
-            self._set_point(self._curves.locate(self._perigee_m, float(apogee_m)))
+            self._set_point(universal_curves().locate(self._perigee_m, float(apogee_m)))
             if self.render_mode is not None:
                 ep.track.append((self._perigee_m, self._apogee_m, dv))
         return dv
@@ -827,7 +822,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         (days to years) into one step's reward. With q from ``at`` throughout, the
         W of successive steps are consistent and each step's days are >= 0.
         """
-        self._perigee_m, self._apogee_m, period_s = self._curves.at(point.label, point.tau)
+        self._perigee_m, self._apogee_m, period_s = universal_curves().at(point.label, point.tau)
         self._point = CurvePoint(point.label, point.tau, period_s)
 
     def _observe(self, weighted_s: float, perigee_drop_m: float, apogee_drop_m: float) -> NDArray[np.float32]:

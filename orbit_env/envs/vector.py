@@ -118,7 +118,6 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._burn_sizes = np.array(self.config.burn_sizes_m_s, dtype=np.float64)
-        self._curves = universal_curves()
         n = self.num_envs
         zeros = np.zeros(n)
         # Curve coordinates (label, tau, mean period), heights and the satellites.
@@ -134,15 +133,6 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._pool: dict[str, Any] = {}
         self._pool_obs = np.zeros((0, 7), dtype=np.float32)
         self._pool_next = n
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = self.__dict__.copy()
-        state["_curves"] = None
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        self.__dict__.update(state)
-        self._curves = universal_curves()
 
     @property
     def state(self) -> dict[str, FloatArray]:
@@ -184,7 +174,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
             self._update_rates(np.arange(self.num_envs))
         perigee_m, apogee_m = self._perigee_m, self._apogee_m
         after, self._perigee_m, self._apogee_m, days, weighted_s = coast(
-            self._curves,
+            universal_curves(),
             CurvePoint(self._label, self._tau, self._period),
             self.config.revolutions_per_step,
             self._nu_per_rev,
@@ -253,7 +243,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
             dv_out[idx] = dv
             self._mass_kg[idx] = mass_kg
             self._update_satellite(idx)
-            self._set_point(idx, self._curves.locate(self._perigee_m[idx], apogee_m))
+            self._set_point(idx, universal_curves().locate(self._perigee_m[idx], apogee_m))
         return idx
 
     def _start(self, idx: NDArray[np.intp], options: dict[str, Any] | None) -> None:
@@ -271,7 +261,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._update_satellite(idx)
         perigee_m = np.broadcast_to(np.asarray(start["perigee_km"]) * 1e3, idx.shape)
         apogee_m = np.broadcast_to(np.asarray(start["apogee_km"]) * 1e3, idx.shape)
-        self._set_point(idx, self._curves.locate(perigee_m, apogee_m))
+        self._set_point(idx, universal_curves().locate(perigee_m, apogee_m))
 
     def _restart(self, idx: NDArray[np.intp]) -> NDArray[np.float32]:
         """Automatic reset of ``idx``: copy fresh missions from the pool; return their observations.
@@ -331,7 +321,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         """Take freshly located orbits; heights and mean period from ``at`` (see the single env's)."""
         self._label[idx] = point.label
         self._tau[idx] = point.tau
-        perigee_m, apogee_m, period_s = self._curves.at(point.label, point.tau)
+        perigee_m, apogee_m, period_s = universal_curves().at(point.label, point.tau)
         self._period[idx] = period_s
         self._perigee_m[idx] = perigee_m
         self._apogee_m[idx] = apogee_m
