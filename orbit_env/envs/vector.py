@@ -171,7 +171,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         if burning.size:
             burning = self._burn(burning, requested[burning], dv)
         if self.density.varies:
-            self._update_rates(np.arange(self.num_envs))
+            self._update_rates(slice(None))
         perigee_m, apogee_m = self._perigee_m, self._apogee_m
         after, self._perigee_m, self._apogee_m, days, weighted_s = coast(
             universal_curves(),
@@ -311,7 +311,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
             self._time_days[idx],
         )
 
-    def _update_rates(self, idx: NDArray[np.intp]) -> None:
+    def _update_rates(self, idx: NDArray[np.intp] | slice) -> None:
         """Set g c s per revolution of ``idx``, s the density scale now (held over the coming step)."""
         scale = self._density_now(idx)
         self._density_scale[idx] = scale
