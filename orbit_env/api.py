@@ -266,6 +266,11 @@ def lifetime(
             rotating_atmosphere=rotating_atmosphere,
             inclination_deg=inclination_deg,
         )
+        if not direct.reentered:
+            raise ValueError(
+                f"the direct integration stopped at its cap of {direct.revolutions:.0f} revolutions before "
+                "re-entry; use --method averaged or curves for lifetimes this long"
+            )
         revolutions = direct.revolutions
         history = DecayHistory(
             revolutions=direct.history_revolutions,
