@@ -8,6 +8,10 @@ from orbit_env.api import LifetimeResult, Satellite, lifetime
 from orbit_env.atmosphere import ExponentialAtmosphere, PaperAtmosphere
 from orbit_env.curves import universal_curves
 from orbit_env.decay import DecayModel
+from orbit_env.envs import register_envs
+
+# `import orbit_env` then `gymnasium.make("OrbitRaising-v0")`: the ids live in one place.
+register_envs()
 
 __all__ = [
     "DecayModel",
