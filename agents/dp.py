@@ -33,7 +33,25 @@ Grid refinement (default config, density scale 1, mean optimum over 200 seeded
 start states of ``OrbitRaising-v0`` (seeds 0..199), one core of a 2-core machine
 shared with a training run):
 
-REFINEMENT_TABLE
+=========  ==========  =========  ==========  ===========  ===========
+labels     states      solve [s]  optimum     DP in env    change of
+                                  (value)     (200 eps)    optimum
+=========  ==========  =========  ==========  ===========  ===========
+24         300 288     12.7*      301.42      297.02       --
+32         400 384     13.7*      301.00      297.45       -0.14%
+48         600 576     10.8       300.76      299.30       -0.08%
+64         800 768     14.9       300.66      299.86       -0.03%
+=========  ==========  =========  ==========  ===========  ===========
+
+(returns in days; life and delta-v levels 1 per step and per 10 m/s: refining
+them, (48, 2, 1) and (48, 1, 2), changed nothing measurable on the test task, as
+their transitions are exact; * measured with a second solve running.) The
+optimum moves by less than 0.5% from 24 labels on; the policy acting on the
+interpolated values needs more: with 24 labels it earns 1.5% less than its
+value, with 48 labels 0.5%, with 64 labels 0.3%. On the same 200 episodes never
+burning returns 261.6 days and the whole tank at once 244.0: the optimum beats
+them by 15% and 23% (value at 48 labels), its policy in the env by 14% and 23%.
+The default grid is (48, 1, 1): about 11 s and 0.9 GB of float32 values.
 """
 
 from __future__ import annotations
