@@ -51,7 +51,9 @@ interpolated values needs more: with 24 labels it earns 1.5% less than its
 value, with 48 labels 0.5%, with 64 labels 0.3%. On the same 200 episodes never
 burning returns 261.6 days and the whole tank at once 244.0: the optimum beats
 them by 15% and 23% (value at 48 labels), its policy in the env by 14% and 23%.
-The default grid is (48, 1, 1): about 11 s and 0.9 GB of float32 values.
+The default grid is (64, 1, 1): about 20 s and 0.6 GB of values stored as uint16
+in steps of 0.01 day. On the evaluation episodes of `orbit-env evaluate` (seed 12345)
+the DP policy earns 262.8, 263.6 and 263.9 days at 48, 64 and 96 labels.
 """
 
 from __future__ import annotations
@@ -89,7 +91,9 @@ from orbit_env.envs.orbit_raising import (
 FloatArray = NDArray[np.float64]
 
 #: Default grid: (labels, life levels per step, delta-v levels per burn quantum).
-DEFAULT_GRID = (48, 1, 1)
+DEFAULT_GRID = (64, 1, 1)
+#: Resolution of the stored values [days].
+VALUE_QUANTUM_DAYS = 0.01
 #: Lowest label on the grid; below it orbits are circular to within metres.
 MU_LOW = -14.0
 #: Labels where 98% of the start orbits of the default config and of their burns
@@ -210,7 +214,7 @@ class DPSolution:
     solve_s: float
     _model: _Model
     _axes: _Axes
-    _values: NDArray[np.float32]  # (horizon + 1, states)
+    _values: NDArray[np.uint16]  # (horizon + 1, states), in units of VALUE_QUANTUM_DAYS
 
     @property
     def num_states(self) -> int:
@@ -235,7 +239,7 @@ class DPSolution:
         for a, burn in enumerate(self.config.burn_sizes_m_s):
             label, life, dv_left, reward = self._model.step(point, mass, burn)
             index, weight = _interpolation(self._axes, label, life, dv_left)
-            future = (self._values[stage[:, None], index] * weight).sum(axis=1)
+            future = (self._values[stage[:, None], index] * weight).sum(axis=1) * VALUE_QUANTUM_DAYS
             q[:, a] = reward + future
         # A re-entered satellite or an ended mission earns nothing more.
         q[(steps_left <= 0) | (point.tau <= 0.0)] = 0.0
@@ -380,11 +384,15 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
     if progress:
         print(f"dp: {n} states x {len(rewards)} actions built in {time.perf_counter() - start:.1f} s", file=sys.stderr)
     horizon = config.horizon_steps
-    values = np.zeros((horizon + 1, n), dtype=np.float32)
+    # Values are stored as uint16 in steps of VALUE_QUANTUM_DAYS: half of float32's memory
+    # (366 stages of up to a million states), far below the grid's own error.
+    values = np.zeros((horizon + 1, n), dtype=np.uint16)
     v = np.zeros(n)
     for k in range(1, horizon + 1):
         v = reduce(np.maximum, [r + p @ v for r, p in zip(rewards, matrices, strict=True)])
-        values[k] = v
+        if v.max() > np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS:
+            raise ValueError(f"values above {np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS:g} days: horizon too long")
+        values[k] = np.rint(np.maximum(v, 0.0) / VALUE_QUANTUM_DAYS)
         if progress and k % 73 == 0:
             print(f"dp: stage {k}/{horizon}, {time.perf_counter() - start:.1f} s", file=sys.stderr)
     return DPSolution(config, density_scale, grid, time.perf_counter() - start, model, axes, values)

@@ -297,6 +297,40 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _cmd_train(args: argparse.Namespace) -> int:
+    from agents.train import train
+
+    result = train(args.config, args.out, total_timesteps=args.timesteps, progress=not args.no_progress)
+    print(f"trained {result.timesteps} timesteps in {result.seconds:.0f} s")
+    print(f"model: {result.model_path}  (tensorboard --logdir {result.log_dir})")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from agents.evaluate import all_policies, evaluate, format_table, plot_returns
+
+    def say(name: str) -> None:
+        if not args.json:
+            print(f"  running {name} ...", file=sys.stderr)
+
+    policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say)
+    results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
+    if args.plot:
+        plot_returns(results, args.env, args.plot)
+    if args.json:
+        print(json.dumps({"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}))
+    else:
+        print(format_table(args.env, args.episodes, args.seed, table))
+    return 0
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The full ``orbit-env`` parser."""
     parser = _Parser(prog=PROG, description="Satellite decay by Okhotsimsky, Eneev and Taratynova (1957).")
@@ -338,6 +372,22 @@ def build_parser() -> argparse.ArgumentParser:
     fig = sub.add_parser("fig2", help="draw the paper's Fig. 2")
     fig.add_argument("--out", default="fig2.png", metavar="PNG", help="output file (default fig2.png)")
     fig.set_defaults(func=_cmd_fig2)
+    tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
+    tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
+    tr.add_argument("--out", default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)")
+    tr.add_argument("--timesteps", type=_positive_int, metavar="N", help="override the config's total_timesteps")
+    tr.add_argument("--no-progress", action="store_true", help="no progress bar")
+    tr.set_defaults(func=_cmd_train)
+
+    ev = sub.add_parser("evaluate", help="every policy on the same seeded episodes: when does a burn pay off?")
+    ev.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
+    ev.add_argument("--episodes", type=_positive_int, default=200, metavar="N", help="episodes (default 200)")
+    ev.add_argument("--seed", type=int, default=12345, metavar="S", help="seed of the episodes (default 12345)")
+    ev.add_argument("--model", metavar="ZIP", help="PPO model (default: the shipped one for the environment)")
+    ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
+    ev.add_argument("--json", action="store_true", help="print one JSON object")
+    ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
+    ev.set_defaults(func=_cmd_evaluate)
     return parser
 
 

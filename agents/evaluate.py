@@ -1,0 +1,273 @@
+"""Score every policy on the same seeded episodes (``orbit-env evaluate``).
+
+The episodes are the first episode of each sub-environment of one seeded vector
+environment: the start orbits (and, in ``OrbitRaisingUncertain-v0``, the hidden
+density) are drawn at reset before any action, so every policy meets the same ones.
+The seeds differ from training's (``agents/ppo.toml`` trains with seed 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import gymnasium
+import numpy as np
+from numpy.typing import NDArray
+
+import orbit_env  # noqa: F401  (registers the environments)
+from agents.policies import HAND_CODED
+from orbit_env.envs import ENV_IDS
+
+FloatArray = NDArray[np.float64]
+
+#: Default seed of the evaluation episodes (training uses 0).
+EVAL_SEED = 12345
+#: Default number of episodes.
+EVAL_EPISODES = 200
+#: Order of the policies in tables and JSON.
+POLICY_ORDER = ("never", "all_at_once", "apogee_threshold", "greedy", "dp", "ppo")
+
+
+class Predictor(Protocol):
+    """Stable-Baselines3's prediction protocol."""
+
+    def predict(
+        self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True
+    ) -> tuple[Any, Any]:
+        """Actions for a batch of observations."""
+        ...
+
+
+@dataclass(frozen=True)
+class Episodes:
+    """Per-episode results of one policy (arrays of length ``episodes``)."""
+
+    returns: FloatArray
+    lifetime_days: FloatArray
+    dv_m_s: FloatArray
+
+    def summary(self) -> dict[str, float]:
+        """Mean and spread, with the public JSON keys (``capture`` is added by :func:`summarize`)."""
+        return {
+            "mean_return": float(self.returns.mean()),
+            "std_return": float(self.returns.std()),
+            "mean_lifetime_days": float(self.lifetime_days.mean()),
+            "mean_dv_m_s": float(self.dv_m_s.mean()),
+        }
+
+
+def check_env_id(env_id: str) -> None:
+    """ValueError unless ``env_id`` is one of the package's environments."""
+    if env_id not in ENV_IDS:
+        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join(ENV_IDS)}")
+
+
+def run_episodes(env_id: str, policy: Predictor, episodes: int = EVAL_EPISODES, seed: int = EVAL_SEED) -> Episodes:
+    """Play one episode per sub-environment of a seeded vector env with ``policy``."""
+    check_env_id(env_id)
+    if episodes < 1:
+        raise ValueError(f"episodes must be >= 1, got {episodes}")
+    env = gymnasium.make_vec(env_id, num_envs=episodes, vectorization_mode="vector_entry_point")
+    obs, _ = env.reset(seed=seed)
+    if hasattr(policy, "bind"):
+        policy.bind(env)  # an oracle reads the hidden state it is told
+    cost = env.unwrapped.config.propellant_cost_per_m_s
+    returns = np.zeros(episodes)
+    days = np.zeros(episodes)
+    dv = np.zeros(episodes)
+    running = np.ones(episodes, dtype=bool)
+    while running.any():
+        actions, _ = policy.predict(obs, deterministic=True)
+        obs, reward, terminated, truncated, info = env.step(actions)
+        burn = np.asarray(info["burn_m_s"], dtype=np.float64)
+        returns += np.where(running, reward, 0.0)
+        days += np.where(running, reward + cost * burn, 0.0)
+        dv += np.where(running, burn, 0.0)
+        running &= ~(terminated | truncated)
+    env.close()
+    return Episodes(returns=returns, lifetime_days=days, dv_m_s=dv)
+
+
+def summarize(results: Mapping[str, Episodes]) -> dict[str, dict[str, float | None]]:
+    """Per-policy summary with capture = (R - R_never) / (R_dp - R_never)."""
+    table: dict[str, dict[str, float | None]] = {}
+    never = results["never"].returns.mean() if "never" in results else None
+    best = results["dp"].returns.mean() if "dp" in results else None
+    for name, result in results.items():
+        row: dict[str, float | None] = dict(result.summary())
+        gain = None if never is None or best is None else best - never
+        row["capture"] = None if gain is None or abs(gain) < 1e-9 else float((result.returns.mean() - never) / gain)
+        table[name] = row
+    return table
+
+
+def evaluate(
+    env_id: str,
+    policies: Mapping[str, Predictor],
+    episodes: int = EVAL_EPISODES,
+    seed: int = EVAL_SEED,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[dict[str, Episodes], dict[str, dict[str, float | None]]]:
+    """Run every policy on the same episodes; return raw results and the summary table."""
+    results = {}
+    for name, policy in policies.items():
+        if progress is not None:
+            progress(name)
+        results[name] = run_episodes(env_id, policy, episodes, seed)
+    return results, summarize(results)
+
+
+def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
+    """The four hand-coded baselines, set up for ``env_id``'s config and action space."""
+    check_env_id(env_id)
+    env = gymnasium.make(env_id)
+    base = env.unwrapped
+    policies: dict[str, Predictor] = {
+        name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()
+    }
+    env.close()
+    return policies
+
+
+def format_table(env_id: str, episodes: int, seed: int, table: Mapping[str, Mapping[str, float | None]]) -> str:
+    """The evaluation as a text table for people."""
+    lines = [
+        f"{env_id}: {episodes} episodes (seed {seed})",
+        f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
+    ]
+    for name, row in table.items():
+        capture = "" if row["capture"] is None else f"{row['capture']:8.0%}"
+        lines.append(
+            f"{name:<17} {row['mean_return']:8.1f} +- {row['std_return']:5.1f} {row['mean_lifetime_days']:13.1f} "
+            f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
+        )
+    lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
+    return "\n".join(lines)
+
+
+def plot_returns(results: Mapping[str, Episodes], env_id: str, path: str) -> None:
+    """Box plot of the episode returns of every policy."""
+    from orbit_env.plotting import pyplot
+
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=120)
+    names = list(results)
+    ax.boxplot([results[n].returns for n in names], showmeans=True)
+    ax.set_xticks(range(1, len(names) + 1), names)
+    ax.set_ylabel("episode return [days - cost x m/s]")
+    ax.set_title(f"{env_id}: returns on {next(iter(results.values())).returns.size} seeded episodes", fontsize=10)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+#: The shipped PPO model of each environment (under ``agents/models``), where there is one.
+SHIPPED_MODELS = {
+    "OrbitRaising-v0": "ppo_orbit_raising.zip",
+    "OrbitRaisingUncertain-v0": "ppo_orbit_raising_uncertain.zip",
+}
+
+
+def load_ppo(env_id: str, model_path: str | None = None) -> Predictor | None:
+    """The PPO model for ``env_id``: the given file, or the shipped one (None if there is none)."""
+    from importlib import resources
+    from pathlib import Path
+
+    try:
+        from stable_baselines3 import PPO
+    except ImportError as error:  # pragma: no cover - depends on the installation
+        raise ImportError("the PPO agent needs stable-baselines3: pip install 'orbit-env[train]'") from error
+    if model_path is None:
+        if env_id not in SHIPPED_MODELS:
+            return None
+        path = Path(str(resources.files("agents").joinpath("models", SHIPPED_MODELS[env_id])))
+    else:
+        path = Path(model_path)
+    if not path.is_file():
+        raise ValueError(f"no PPO model at {path}")
+    return PPO.load(path, device="cpu")
+
+
+def all_policies(
+    env_id: str,
+    model_path: str | None = None,
+    include_dp: bool = True,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, Predictor]:
+    """Hand-coded baselines, the DP optimum (if asked) and PPO, in :data:`POLICY_ORDER`."""
+    policies = hand_coded_policies(env_id)
+    if include_dp:
+        if progress is not None:
+            progress("dp (solving)")
+        policies["dp"] = dp_policy(env_id)
+    ppo = load_ppo(env_id, model_path)
+    if ppo is not None:
+        policies["ppo"] = ppo
+    return {name: policies[name] for name in POLICY_ORDER if name in policies}
+
+
+class ContinuousFromDiscrete:
+    """Acts in the continuous variant with a policy over the discrete burn sizes (a = dv / max burn)."""
+
+    def __init__(self, policy: Predictor, burn_sizes_m_s: tuple[float, ...], max_burn_m_s: float) -> None:
+        self.policy = policy
+        self.actions = np.clip(np.asarray(burn_sizes_m_s) / max_burn_m_s, 0.0, 1.0).astype(np.float32)
+
+    def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True):
+        """The discrete policy's burn as a Box action."""
+        index, state = self.policy.predict(observation, state, episode_start, deterministic)
+        return self.actions[np.asarray(index)][..., None], state
+
+
+class OracleDP:
+    """The optimum told the density: DP solutions on a ladder of density scales.
+
+    In ``OrbitRaisingUncertain-v0`` every step it reads each satellite's true current
+    density scale from the environment and acts by the DP solved at the nearest rung
+    (log spacing, ``rungs`` over the scale range). It plans as if that scale then
+    stayed constant, so with the slow solar-cycle drift it is a near-optimal
+    reference, not an exact bound.
+    """
+
+    def __init__(self, config: Any, scale_range: tuple[float, float], rungs: int = 9) -> None:
+        from agents.dp import DPPolicy
+
+        self.scales = np.geomspace(scale_range[0], scale_range[1], rungs)
+        self.policies = [DPPolicy(config, density_scale=float(s)) for s in self.scales]
+        self.env: Any = None
+
+    def bind(self, env: Any) -> None:
+        """The vector environment whose hidden density the oracle is told."""
+        self.env = env
+
+    def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True):
+        """Each satellite acts by the DP of its density rung."""
+        if self.env is None:
+            raise ValueError("OracleDP needs bind(vector_env) before predict")
+        obs = np.atleast_2d(np.asarray(observation))
+        scale = self.env.state["density_scale"]
+        rung = np.abs(np.log(scale)[:, None] - np.log(self.scales)[None, :]).argmin(axis=1)
+        actions = np.zeros(obs.shape[0], dtype=np.int64)
+        for k in np.unique(rung):
+            mine = rung == k
+            actions[mine] = self.policies[k].predict(obs[mine])[0]
+        return actions, state
+
+
+def dp_policy(env_id: str) -> Predictor:
+    """The optimum for ``env_id``: DP on the known density, its continuous form, or the oracle."""
+    from agents.dp import DPPolicy
+
+    check_env_id(env_id)
+    env = gymnasium.make(env_id)
+    base = env.unwrapped
+    env.close()
+    if base.density.scale_range[0] != base.density.scale_range[1]:
+        return OracleDP(base.config, base.density.scale_range)
+    policy = DPPolicy(base.config, density_scale=base.density.nominal_scale)
+    if base.continuous:
+        return ContinuousFromDiscrete(policy, base.config.burn_sizes_m_s, base.config.max_burn_m_s)
+    return policy

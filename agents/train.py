@@ -1,0 +1,147 @@
+"""PPO with Stable-Baselines3 on the numpy-batched vector environment (``orbit-env train``).
+
+All hyperparameters live in a TOML file (default: ``agents/ppo.toml``, shipped with the
+package); the run writes tensorboard logs, checkpoints and the final model to one
+folder. The shipped model ``agents/models/ppo_orbit_raising.zip`` is this command's
+output with the default file::
+
+    orbit-env train --out runs/ppo && cp runs/ppo/model.zip agents/models/ppo_orbit_raising.zip
+"""
+
+from __future__ import annotations
+
+import time
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+#: The hyperparameter file of the shipped model.
+DEFAULT_CONFIG = "ppo.toml"
+#: The shipped model, trained by ``orbit-env train`` with :data:`DEFAULT_CONFIG`.
+SHIPPED_MODEL = "models/ppo_orbit_raising.zip"
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """Where a training run left its files and how long it took."""
+
+    model_path: Path
+    log_dir: Path
+    seconds: float
+    timesteps: int
+
+
+def _mission_end_is_terminal(venv: Any) -> Any:
+    """Wrap ``venv`` so that the mission's end is terminal (see the class)."""
+    from stable_baselines3.common.vec_env import VecEnvWrapper
+
+    class MissionEndIsTerminal(VecEnvWrapper):
+        """Treat the horizon as the end of the task: no value bootstrapped past it.
+
+        The environments reward days *within* the mission and show the mission clock,
+        so the state at the horizon is terminal for the task; SB3 would otherwise add
+        the value of the life after the mission (Pardo et al. 2018, time limits in RL).
+        """
+
+        def reset(self) -> Any:
+            return self.venv.reset()
+
+        def step_wait(self) -> Any:
+            obs, rewards, dones, infos = self.venv.step_wait()
+            for info in infos:
+                info.pop("TimeLimit.truncated", None)
+            return obs, rewards, dones, infos
+
+    return MissionEndIsTerminal(venv)
+
+
+def load_config(path: str | Path | None = None) -> dict[str, Any]:
+    """Read a training config (default: the shipped ``agents/ppo.toml``)."""
+    if path is None:
+        text = resources.files("agents").joinpath(DEFAULT_CONFIG).read_text()
+    else:
+        text = Path(path).read_text()
+    config = tomllib.loads(text)
+    for key in ("env_id", "seed", "num_envs", "total_timesteps", "ppo", "policy"):
+        if key not in config:
+            raise ValueError(f"training config {path or DEFAULT_CONFIG} lacks the key {key!r}")
+    if int(config["total_timesteps"]) <= 0 or int(config["num_envs"]) <= 0:
+        raise ValueError("total_timesteps and num_envs must be positive integers")
+    return config
+
+
+def shipped_model_path() -> Path:
+    """Path of the model shipped with the package."""
+    return Path(str(resources.files("agents").joinpath(SHIPPED_MODEL)))
+
+
+def train(
+    config_path: str | Path | None = None,
+    out_dir: str | Path = "runs/ppo",
+    *,
+    total_timesteps: int | None = None,
+    progress: bool = True,
+) -> TrainResult:
+    """Train PPO as the config says; return where the model went.
+
+    Args:
+        config_path: TOML file of hyperparameters (default: the shipped one).
+        out_dir: Folder for ``model.zip``, ``checkpoints/`` and ``tensorboard/``.
+        total_timesteps: Override the config's budget (smoke tests use a tiny one).
+        progress: Show SB3's progress bar.
+    """
+    try:
+        import torch
+        from stable_baselines3 import PPO
+        from stable_baselines3.common.callbacks import CheckpointCallback
+        from stable_baselines3.common.vec_env import VecNormalize
+    except ImportError as error:  # pragma: no cover - depends on the installation
+        raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
+
+    import orbit_env  # noqa: F401  (registers the environments)
+    from orbit_env.envs.sb3 import make_sb3_vec_env
+
+    config = load_config(config_path)
+    timesteps = int(total_timesteps if total_timesteps is not None else config["total_timesteps"])
+    if timesteps <= 0:
+        raise ValueError(f"total_timesteps must be positive, got {timesteps}")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
+    seed = int(config["seed"])
+    venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed)
+    if not config.get("bootstrap_at_horizon", True):
+        venv = _mission_end_is_terminal(venv)
+    if config.get("normalize", {}).get("reward", False):
+        venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=float(config["ppo"]["gamma"]))
+    activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
+    model = PPO(
+        "MlpPolicy",
+        venv,
+        seed=seed,
+        verbose=0,
+        device="cpu",
+        tensorboard_log=str(out / "tensorboard"),
+        policy_kwargs={"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation},
+        **config["ppo"],
+    )
+    coast_logit = float(config["policy"].get("initial_coast_logit", 0.0))
+    if coast_logit:
+        # Burns are rare decisions: a uniform initial policy burns a third of the time and
+        # empties the tank in days, so it never learns what keeping propellant is worth.
+        with torch.no_grad():
+            model.policy.action_net.bias[0] += coast_logit
+    callbacks = []
+    every = int(config.get("checkpoint_every", 0))
+    if every > 0:
+        callbacks.append(
+            CheckpointCallback(save_freq=max(every // int(config["num_envs"]), 1), save_path=str(out / "checkpoints"))
+        )
+    start = time.perf_counter()
+    model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
+    seconds = time.perf_counter() - start
+    model_path = out / "model.zip"
+    model.save(model_path, exclude=["env", "tensorboard_log"])
+    return TrainResult(model_path=model_path, log_dir=out / "tensorboard", seconds=seconds, timesteps=timesteps)
