@@ -69,6 +69,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from agents.policies import observation_batch
 from orbit_env.constants import REENTRY_ALTITUDE_M
 from orbit_env.curves import (
     CURVES_MAX_APOGEE_M,
@@ -433,14 +434,11 @@ class DPPolicy:
         deterministic: bool = True,
     ) -> tuple[Any, Any]:
         """Actions for one observation (7,) or a batch (n, 7); SB3's signature."""
-        obs = np.asarray(observation, dtype=np.float64)
-        if obs.ndim not in (1, 2) or obs.shape[-1:] != (7,) or not np.all(np.isfinite(obs)):
-            raise ValueError(f"observation must be finite with shape (7,) or (n, 7), got shape {obs.shape}")
-        batch = np.atleast_2d(obs)
+        batch = observation_batch(observation)
         perigee = np.clip(batch[:, 0] * HEIGHT_SCALE_M, REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M)
         apogee = np.clip(batch[:, 1] * HEIGHT_SCALE_M, perigee, CURVES_MAX_APOGEE_M)
         dv_left = np.maximum(batch[:, 2] * DV_SCALE_M_S, 0.0)
         horizon = self.config.horizon_steps
         steps_left = horizon - np.rint(np.clip(batch[:, 3], 0.0, 1.0) * horizon).astype(np.intp)
         actions = np.argmax(self.solution.q_values(perigee, apogee, dv_left, steps_left), axis=1).astype(np.int64)
-        return (actions[0] if obs.ndim == 1 else actions), state
+        return (actions[0] if np.ndim(observation) == 1 else actions), state

@@ -45,22 +45,28 @@ def burn_map(
     return maps
 
 
-def plot_burn_maps(maps: Mapping[str, np.ndarray], perigee_km: np.ndarray, apogee_km: np.ndarray, path: str) -> None:
-    """Side-by-side maps of the first burn."""
+def plot_burn_maps(
+    maps: Mapping[str, np.ndarray], perigee_km: np.ndarray, apogee_km: np.ndarray, sizes: np.ndarray, path: str
+) -> None:
+    """Side-by-side maps of the first burn, one colour per burn size."""
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
     from orbit_env.plotting import pyplot
 
     plt = pyplot()
+    colours = ListedColormap(plt.get_cmap("viridis")(np.linspace(0.0, 1.0, sizes.size)))
+    edges = np.concatenate([[sizes[0] - 1.0], (sizes[1:] + sizes[:-1]) / 2, [sizes[-1] + 1.0]])
+    norm = BoundaryNorm(edges, colours.N)
     fig, axes = plt.subplots(1, len(maps), figsize=(5.2 * len(maps), 4.6), dpi=120, sharey=True)
     axes = np.atleast_1d(axes)
     for ax, (name, grid) in zip(axes, maps.items(), strict=True):
-        image = ax.pcolormesh(
-            apogee_km, perigee_km, grid, cmap="viridis", vmin=0, vmax=np.nanmax(grid) or 1, shading="auto"
-        )
+        image = ax.pcolormesh(apogee_km, perigee_km, grid, cmap=colours, norm=norm, shading="nearest")
         ax.plot([perigee_km[0], perigee_km[-1]], [perigee_km[0], perigee_km[-1]], color="0.5", lw=0.8)
         ax.set_title(f"{name}: first burn at a full tank", fontsize=10)
         ax.set_xlabel("apogee height [km]")
     axes[0].set_ylabel("perigee height [km]")
-    fig.colorbar(image, ax=list(axes), label="burn [m/s]")
+    bar = fig.colorbar(image, ax=list(axes), ticks=sizes)
+    bar.set_label("burn [m/s]")
     fig.savefig(path)
     plt.close(fig)
 
@@ -77,7 +83,8 @@ def main(argv: list[str] | None = None) -> None:
     apogee = np.linspace(160.0, 1600.0, 145)
     policies = {"dp (optimum)": dp_policy(args.env), "ppo": load_ppo(args.env)}
     maps = burn_map(args.env, policies, perigee, apogee)
-    plot_burn_maps(maps, perigee, apogee, args.out)
+    sizes = np.asarray(start_observations(args.env, perigee[:1], perigee[:1])[1].burn_sizes_m_s)
+    plot_burn_maps(maps, perigee, apogee, sizes, args.out)
     for name, grid in maps.items():
         print(
             f"{name}: burns at {np.nanmean(grid > 0):.0%} of start orbits, mean first burn {np.nanmean(grid):.1f} m/s"

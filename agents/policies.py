@@ -28,6 +28,18 @@ from orbit_env.orbit import dv_for_apogee_m_s
 FloatArray = NDArray[np.float64]
 
 
+def observation_batch(observation: Any) -> FloatArray:
+    """One observation (7,) or a batch (n, 7) as a finite float64 batch (n, 7).
+
+    Raises:
+        ValueError: another shape, or a value that is not finite.
+    """
+    obs = np.asarray(observation, dtype=np.float64)
+    if obs.ndim not in (1, 2) or obs.shape[-1:] != (7,) or not np.all(np.isfinite(obs)):
+        raise ValueError(f"observation must be finite with shape (7,) or (n, 7), got shape {obs.shape}")
+    return np.atleast_2d(obs)
+
+
 class BurnPolicy:
     """Shared plumbing: decode observations, encode burns as actions.
 
@@ -79,11 +91,9 @@ class BurnPolicy:
         deterministic: bool = True,
     ) -> tuple[Any, Any]:
         """Actions for one observation (7,) or a batch (n, 7); SB3's signature."""
-        obs = np.asarray(observation, dtype=np.float32)
-        if obs.shape[-1:] != (7,) or obs.ndim not in (1, 2):
-            raise ValueError(f"observation must have shape (7,) or (n, 7), got {obs.shape}")
-        actions = self.encode(self.burns_m_s(np.atleast_2d(obs)))
-        return (actions[0] if obs.ndim == 1 else actions), state
+        obs = observation_batch(observation)
+        actions = self.encode(self.burns_m_s(obs))
+        return (actions[0] if np.ndim(observation) == 1 else actions), state
 
 
 class NeverBurn(BurnPolicy):

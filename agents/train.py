@@ -67,6 +67,9 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     for key in ("env_id", "seed", "num_envs", "total_timesteps", "ppo", "policy"):
         if key not in config:
             raise ValueError(f"training config {path or DEFAULT_CONFIG} lacks the key {key!r}")
+    schedule = config.get("learning_rate_schedule", "constant")
+    if schedule not in ("constant", "linear"):
+        raise ValueError(f"learning_rate_schedule={schedule!r} is invalid; allowed: constant, linear")
     if int(config["total_timesteps"]) <= 0 or int(config["num_envs"]) <= 0:
         raise ValueError("total_timesteps and num_envs must be positive integers")
     return config
@@ -117,6 +120,11 @@ def train(
     if config.get("normalize", {}).get("reward", False):
         venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=float(config["ppo"]["gamma"]))
     activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
+    ppo_kwargs = dict(config["ppo"])
+    if config.get("learning_rate_schedule", "constant") == "linear":
+        # SB3 calls the schedule with the progress left, from 1 down to 0.
+        start_rate = float(ppo_kwargs["learning_rate"])
+        ppo_kwargs["learning_rate"] = lambda progress_left: start_rate * progress_left
     model = PPO(
         "MlpPolicy",
         venv,
@@ -125,7 +133,7 @@ def train(
         device="cpu",
         tensorboard_log=str(out / "tensorboard"),
         policy_kwargs={"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation},
-        **config["ppo"],
+        **ppo_kwargs,
     )
     coast_logit = float(config["policy"].get("initial_coast_logit", 0.0))
     if coast_logit:

@@ -123,6 +123,29 @@ class LifetimeResult:
     method: str
     history: DecayHistory = field(repr=False)
 
+    @classmethod
+    def from_si(
+        cls,
+        perigee_m: float,
+        apogee_m: float,
+        nu: float,
+        revolutions: float,
+        days: float,
+        method: str,
+        history: DecayHistory,
+    ) -> LifetimeResult:
+        """The result of a decay from SI start heights (the perigee velocity is derived)."""
+        return cls(
+            perigee_km=perigee_m / 1e3,
+            apogee_km=apogee_m / 1e3,
+            nu=nu,
+            revolutions=revolutions,
+            days=days,
+            perigee_velocity_m_s=float(perigee_velocity_m_s(perigee_m, apogee_m)),
+            method=method,
+            history=history,
+        )
+
     def to_dict(self) -> dict[str, Any]:
         """The result without the history, JSON-ready."""
         return {
@@ -308,16 +331,7 @@ def lifetime(
             nu_remaining=nu - path.nu,
         )
         revolutions, days = nu * per_nu, weighted * to_days
-    return LifetimeResult(
-        perigee_km=hp_m / 1e3,
-        apogee_km=ha_m / 1e3,
-        nu=nu,
-        revolutions=revolutions,
-        days=days,
-        perigee_velocity_m_s=float(perigee_velocity_m_s(hp_m, ha_m)),
-        method=method,
-        history=history,
-    )
+    return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
 
 
 def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
@@ -370,16 +384,7 @@ def _lifetime_under_activity(
         apogee_km=ha_path / 1e3,
         nu_remaining=np.linspace(nu, 0.0, t.size),
     )
-    return LifetimeResult(
-        perigee_km=hp_m / 1e3,
-        apogee_km=ha_m / 1e3,
-        nu=nu,
-        revolutions=revolutions,
-        days=days,
-        perigee_velocity_m_s=float(perigee_velocity_m_s(hp_m, ha_m)),
-        method=method,
-        history=history,
-    )
+    return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
 
 
 def check_rule(
