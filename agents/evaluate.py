@@ -138,7 +138,7 @@ def format_table(env_id: str, episodes: int, seed: int, table: Mapping[str, Mapp
         f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
     ]
     for name, row in table.items():
-        capture = "" if row["capture"] is None else f"{row['capture']:8.0%}"
+        capture = "" if row["capture"] is None else f"{row['capture']:8.1%}"
         lines.append(
             f"{name:<17} {row['mean_return']:8.1f} +- {row['std_return']:5.1f} {row['mean_lifetime_days']:13.1f} "
             f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
