@@ -478,6 +478,19 @@ def resolve_options(
     return merged
 
 
+def resolve_task(
+    config: OrbitRaisingConfig | None, density: DensityConfig | None
+) -> tuple[OrbitRaisingConfig, DensityConfig]:
+    """The config and density of an environment (defaults for None); ValueError for other types."""
+    config = OrbitRaisingConfig() if config is None else config
+    density = DensityConfig() if density is None else density
+    if not isinstance(config, OrbitRaisingConfig):
+        raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig")
+    if not isinstance(density, DensityConfig):
+        raise ValueError(f"density={density!r} is invalid; allowed: a DensityConfig")
+    return config, density
+
+
 def observation_space() -> spaces.Box:
     """The observation space shared by all variants (see :class:`OrbitRaisingEnv`)."""
     return spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
@@ -645,12 +658,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         density: DensityConfig | None = None,
         render_mode: str | None = None,
     ) -> None:
-        self.config = OrbitRaisingConfig() if config is None else config
-        self.density = DensityConfig() if density is None else density
-        if not isinstance(self.config, OrbitRaisingConfig):
-            raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig")
-        if not isinstance(self.density, DensityConfig):
-            raise ValueError(f"density={density!r} is invalid; allowed: a DensityConfig")
+        self.config, self.density = resolve_task(config, density)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode={render_mode!r} is invalid; allowed: {self.metadata['render_modes']} or None"

@@ -30,6 +30,7 @@ from orbit_env.envs.orbit_raising import (
     observation_space,
     perigee_burn,
     resolve_options,
+    resolve_task,
     sample_start,
 )
 
@@ -97,12 +98,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
     ) -> None:
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
             raise ValueError(f"num_envs={num_envs!r} is invalid; allowed: an integer >= 1")
-        self.config = OrbitRaisingConfig() if config is None else config
-        self.density = DensityConfig() if density is None else density
-        if not isinstance(self.config, OrbitRaisingConfig):
-            raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig")
-        if not isinstance(self.density, DensityConfig):
-            raise ValueError(f"density={density!r} is invalid; allowed: a DensityConfig")
+        self.config, self.density = resolve_task(config, density)
         if max_episode_steps is not None and max_episode_steps != self.config.horizon_steps:
             raise ValueError(
                 f"max_episode_steps={max_episode_steps} but config.horizon_steps={self.config.horizon_steps}; "
