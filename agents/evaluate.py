@@ -167,7 +167,7 @@ def plot_returns(results: Mapping[str, Episodes], env_id: str, path: str) -> Non
 #: The shipped PPO model of each environment (under ``agents/models``), where there is one.
 SHIPPED_MODELS = {
     "OrbitRaising-v0": "ppo_orbit_raising.zip",
-    "OrbitRaisingUncertain-v0": "ppo_orbit_raising.zip",  # trained on the known density
+    "OrbitRaisingUncertain-v0": "ppo_orbit_raising_uncertain.zip",
 }
 
 
