@@ -119,16 +119,18 @@ def evaluate(
     return results, summarize(results)
 
 
-def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
-    """The four hand-coded baselines, set up for ``env_id``'s config and action space."""
+def task_of(env_id: str) -> Any:
+    """The unwrapped single environment of ``env_id``: its config, density and action kind."""
     check_env_id(env_id)
     env = gymnasium.make(env_id)
-    base = env.unwrapped
-    policies: dict[str, Predictor] = {
-        name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()
-    }
     env.close()
-    return policies
+    return env.unwrapped
+
+
+def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
+    """The four hand-coded baselines, set up for ``env_id``'s config and action space."""
+    base = task_of(env_id)
+    return {name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()}
 
 
 def format_table(env_id: str, episodes: int, seed: int, table: Mapping[str, Mapping[str, float | None]]) -> str:
@@ -261,10 +263,7 @@ def dp_policy(env_id: str) -> Predictor:
     """The optimum for ``env_id``: DP on the known density, its continuous form, or the oracle."""
     from agents.dp import DPPolicy
 
-    check_env_id(env_id)
-    env = gymnasium.make(env_id)
-    base = env.unwrapped
-    env.close()
+    base = task_of(env_id)
     if base.density.scale_range[0] != base.density.scale_range[1]:
         return OracleDP(base.config, base.density.scale_range)
     policy = DPPolicy(base.config, density_scale=base.density.nominal_scale)

@@ -73,7 +73,7 @@ def plot_burn_maps(
 
 def main(argv: list[str] | None = None) -> None:
     """Draw the DP and PPO burn maps of ``OrbitRaising-v0``."""
-    from agents.evaluate import dp_policy, load_ppo
+    from agents.evaluate import dp_policy, load_ppo, task_of
 
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", default="burn_map.png")
@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> None:
     apogee = np.linspace(160.0, 1600.0, 145)
     policies = {"dp (optimum)": dp_policy(args.env), "ppo": load_ppo(args.env)}
     maps = burn_map(args.env, policies, perigee, apogee)
-    sizes = np.asarray(start_observations(args.env, perigee[:1], perigee[:1])[1].burn_sizes_m_s)
+    sizes = np.asarray(task_of(args.env).config.burn_sizes_m_s)
     plot_burn_maps(maps, perigee, apogee, sizes, args.out)
     for name, grid in maps.items():
         print(
