@@ -95,13 +95,17 @@ def apogee_after_perigee_burn_m(perigee_m: ArrayLike, apogee_m: ArrayLike, dv_m_
     """Apogee height [m] after a tangential burn of ``dv_m_s`` at perigee (exact vis-viva).
 
     A prograde burn (``dv_m_s >= 0``) at perigee keeps the perigee and raises the
-    apogee; the result is clamped so that round-off never lowers it. The caller
-    must keep the burn below escape (see :func:`escape_dv_m_s`).
+    apogee; the result is clamped so that round-off never lowers it. A burn at or
+    beyond escape (see :func:`escape_dv_m_s`) returns 2e300 m: unbounded.
     """
-    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
-    v = perigee_velocity_m_s(perigee_m, apogee_m) + np.asarray(dv_m_s, dtype=np.float64)
+    rp = np.add(perigee_m, EARTH_RADIUS_M)
+    ra = np.add(apogee_m, EARTH_RADIUS_M)
+    # Vis-viva at perigee, v^2 = 2 fM ra / (rp (rp + ra)), written in few operations:
+    # a batch of a few dozen burning satellites costs numpy calls, not arithmetic.
+    v = np.sqrt(2.0 * MU_EARTH_M3_S2 * ra / (rp * (rp + ra))) + dv_m_s
     inverse_a = 2.0 / rp - v * v / MU_EARTH_M3_S2
-    return np.maximum(2.0 / inverse_a - rp - EARTH_RADIUS_M, np.asarray(apogee_m, dtype=np.float64))
+    # A burn to escape (1/a <= 0) has no apogee: the floor on 1/a puts it beyond any bound (2e300 m).
+    return np.maximum(2.0 / np.maximum(inverse_a, 1e-300) - rp - EARTH_RADIUS_M, apogee_m)
 
 
 def escape_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:

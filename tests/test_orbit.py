@@ -9,6 +9,7 @@ from orbit_env.orbit import (
     apogee_after_perigee_burn_m,
     dv_for_apogee_m_s,
     elements_from_heights,
+    escape_dv_m_s,
     heights_from_elements,
     perigee_velocity_m_s,
     validate_heights,
@@ -68,3 +69,9 @@ def test_invalid_heights_name_the_value(hp, ha, match):
 def test_target_below_apogee_is_rejected():
     with pytest.raises(ValueError, match="only raises the apogee"):
         dv_for_apogee_m_s(300e3, 800e3, 700e3)
+
+
+def test_a_burn_to_escape_has_an_unbounded_apogee():
+    escape = float(escape_dv_m_s(300e3, 500e3))
+    assert apogee_after_perigee_burn_m(300e3, 500e3, escape * 0.999) < 1e11  # still bound: 1.2e10 m
+    assert apogee_after_perigee_burn_m(300e3, 500e3, escape * 1.001) > 1e299  # not the old apogee

@@ -314,7 +314,7 @@ def validate_satellite(
 
 def delta_v_left_m_s(mass_kg: ArrayLike, dry_mass_kg: ArrayLike, exhaust_velocity_m_s: ArrayLike) -> FloatArray:
     """Delta-v the propellant on board still gives, Tsiolkovsky: v_e ln(m / m_dry) [m/s]."""
-    return np.asarray(exhaust_velocity_m_s) * np.log(np.asarray(mass_kg) / np.asarray(dry_mass_kg))
+    return exhaust_velocity_m_s * np.log(np.divide(mass_kg, dry_mass_kg))
 
 
 def perigee_burn(
@@ -337,15 +337,15 @@ def perigee_burn(
     dv_fuel = delta_v_left_m_s(mass_kg, dry_mass_kg, exhaust_velocity_m_s)
     dv = np.maximum(np.minimum(requested_dv_m_s, dv_fuel), 0.0)
     apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
-    # Beyond the cap, or hyperbolic (a negative apogee): burn only up to the cap. Rare,
-    # so the cap's burn is computed only when some burn needs it.
-    over = ~((apogee_after >= apogee_m) & (apogee_after <= CURVES_MAX_APOGEE_M))
+    # Beyond the cap (escape included: its apogee is unbounded): burn only up to the cap.
+    # Rare, so the cap's burn is computed only when some burn needs it.
+    over = apogee_after > CURVES_MAX_APOGEE_M
     if np.any(over):
         dv_cap = perigee_velocity_m_s(perigee_m, CURVES_MAX_APOGEE_M) - perigee_velocity_m_s(perigee_m, apogee_m)
         dv = np.where(over, np.maximum(np.minimum(dv, dv_cap), 0.0), dv)
         apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
     apogee_after = np.minimum(apogee_after, CURVES_MAX_APOGEE_M)
-    mass_after = np.asarray(mass_kg) * np.exp(-dv / np.asarray(exhaust_velocity_m_s))
+    mass_after = mass_kg * np.exp(-dv / exhaust_velocity_m_s)
     # Emptying the tank leaves exactly the dry mass (the exponential rounds either way).
     mass_after = np.where(dv >= dv_fuel, dry_mass_kg, np.maximum(mass_after, dry_mass_kg))
     return dv, apogee_after, mass_after
@@ -399,9 +399,9 @@ def observation(
     Plain arithmetic only, so that it costs nothing on floats and broadcasts on arrays.
     """
     return (
-        perigee_m / HEIGHT_SCALE_M,
-        apogee_m / HEIGHT_SCALE_M,
-        dv_left_m_s / DV_SCALE_M_S,
+        perigee_m * (1.0 / HEIGHT_SCALE_M),  # multiplications: half the cost of divisions on arrays
+        apogee_m * (1.0 / HEIGHT_SCALE_M),
+        dv_left_m_s * (1.0 / DV_SCALE_M_S),
         mission_clock,
         lifetime_days / (lifetime_days + LIFETIME_SCALE_DAYS),
         apogee_drop_m / (apogee_drop_m + APOGEE_DROP_SCALE_M),
@@ -722,7 +722,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         self._time_days = 0.0
         self._steps = 0
         self._update_satellite()
-        self._set_point(universal_curves().locate(float(start["perigee_km"]) * 1e3, float(start["apogee_km"]) * 1e3))
+        self._set_point(float(start["perigee_km"]) * 1e3, float(start["apogee_km"]) * 1e3)
         self._last_obs = self._observe(self._point.weighted_s, 0.0, 0.0)
         if self.render_mode is not None:
             ep.track.append((self._perigee_m, self._apogee_m, 0.0))
@@ -791,7 +791,7 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         if dv > 0.0:
             ep.mass_kg = float(mass_kg)
             self._update_satellite()
-            self._set_point(universal_curves().locate(self._perigee_m, float(apogee_m)))
+            self._set_point(self._perigee_m, float(apogee_m))
             if self.render_mode is not None:
                 ep.track.append((self._perigee_m, self._apogee_m, dv))
         return dv
@@ -820,18 +820,14 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         ep.density_scale = scale
         ep.nu_per_rev = nu_per_revolution(ep.drag_area_m2 / ep.mass_kg, scale)
 
-    def _set_point(self, point: CurvePoint) -> None:
-        """Take a freshly located orbit, with heights and mean period from the curves' ``at``.
+    def _set_point(self, perigee_m: float, apogee_m: float) -> None:
+        """Locate a new orbit (start or burn) and take its heights as the curves give them.
 
-        ``locate`` and ``at`` interpolate two different tables whose mean periods
-        differ by up to 0.6% (their interpolation errors). A step's time is a drop
-        of W = q nu, and ``advance`` takes q from ``at``'s table: q from ``locate``
-        at the start of a coast would put that 0.6% of the whole remaining W
-        (days to years) into one step's reward. With q from ``at`` throughout, the
-        W of successive steps are consistent and each step's days are >= 0.
+        The heights then come from the same table before and after every coast, so
+        the observed decay of a step is never the locate-and-read-back round trip's
+        interpolation error (``UniversalCurves.locate_heights``).
         """
-        self._perigee_m, self._apogee_m, period_s = universal_curves().at(point.label, point.tau)
-        self._point = CurvePoint(point.label, point.tau, period_s)
+        self._point, self._perigee_m, self._apogee_m = universal_curves().locate_heights(perigee_m, apogee_m)
 
     def _observe(self, weighted_s: float, perigee_drop_m: float, apogee_drop_m: float) -> NDArray[np.float32]:
         ep = self._ep

@@ -65,7 +65,8 @@ class OrbitRaisingVectorEnv(VectorEnv):
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": [], "autoreset_mode": AutoresetMode.SAME_STEP}
 
-    #: Per-satellite state arrays, all of shape (num_envs,).
+    #: Per-satellite state: the rows of one (len(_STATE), num_envs) array, each bound to its attribute
+    #: as a view (so an automatic reset copies a whole mission in one assignment).
     _STATE = (
         "_label",
         "_tau",
@@ -114,21 +115,29 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._burn_sizes = np.array(self.config.burn_sizes_m_s, dtype=np.float64)
-        n = self.num_envs
-        zeros = np.zeros(n)
-        # Curve coordinates (label, tau, mean period), heights and the satellites.
-        self._label, self._tau, self._period = zeros.copy(), zeros.copy(), zeros.copy()
-        self._perigee_m, self._apogee_m = zeros.copy(), zeros.copy()
-        self._mass_kg, self._dry_mass_kg, self._exhaust_m_s = zeros.copy(), zeros.copy(), zeros.copy()
-        self._drag_area_m2, self._density_base, self._density_phase = zeros.copy(), zeros.copy(), zeros.copy()
-        # _nominal_w_per_day: g c s0 x 1 day, with the nominal density: W / it is the predicted lifetime [days].
-        self._nu_per_rev, self._nominal_w_per_day, self._dv_left_m_s = zeros.copy(), zeros.copy(), zeros.copy()
-        self._time_days, self._density_scale = zeros.copy(), zeros.copy()
-        self._steps = np.zeros(n, dtype=np.int64)
+        # Curve coordinates (label, tau, mean period), heights, the satellites, the clock (steps: whole
+        # numbers, exact in float64). _nominal_w_per_day: g c s0 x 1 day with the nominal density; W over
+        # it is the predicted lifetime [days].
+        self._state = np.zeros((len(self._STATE), self.num_envs))
+        self._bind_state()
         self._has_state = False
-        self._pool: dict[str, Any] = {}
+        self._pool = np.zeros((len(self._STATE), 0))
         self._pool_obs = np.zeros((0, 7), dtype=np.float32)
-        self._pool_next = n
+        self._pool_next = self.num_envs
+        self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
+        self._everyone_mask.flags.writeable = False
+
+    def _bind_state(self) -> None:
+        for name, row in zip(self._STATE, self._state, strict=True):
+            setattr(self, name, row)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle the state array once, not its row views (which would unpickle as copies)."""
+        return {key: value for key, value in self.__dict__.items() if key not in self._STATE}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._bind_state()
 
     @property
     def state(self) -> dict[str, FloatArray]:
@@ -168,30 +177,33 @@ class OrbitRaisingVectorEnv(VectorEnv):
             burning = self._burn(burning, requested[burning], dv)
         if self.density.varies:
             self._update_rates(slice(None))
-        perigee_m, apogee_m = self._perigee_m, self._apogee_m
-        after, self._perigee_m, self._apogee_m, days, weighted_s = coast(
+        after, perigee_m, apogee_m, days, weighted_s = coast(
             universal_curves(),
             CurvePoint(self._label, self._tau, self._period),
             self.config.revolutions_per_step,
             self._nu_per_rev,
         )
-        self._tau, self._period = after.tau, after.mean_period_s
+        perigee_drop_m = self._perigee_m - perigee_m
+        apogee_drop_m = self._apogee_m - apogee_m
+        self._perigee_m[...] = perigee_m
+        self._apogee_m[...] = apogee_m
+        self._tau[...] = after.tau
+        self._period[...] = after.mean_period_s
         self._time_days += days
         self._steps += 1
-        obs = self._observe(weighted_s, perigee_m - self._perigee_m, apogee_m - self._apogee_m)
+        obs = self._observe(weighted_s, perigee_drop_m, apogee_drop_m)
         reward = days
-        if burning.size:
+        if burning.size and self.config.propellant_cost_per_m_s:
             reward[burning] -= self.config.propellant_cost_per_m_s * dv[burning]
         terminated = self._tau <= 0.0
         # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         truncated = self._steps >= self.config.horizon_steps
-        infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": np.ones(self.num_envs, dtype=np.bool_)}
+        infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._everyone_mask}
         done = terminated | truncated
-        if done.any():
-            finished = np.flatnonzero(done)
+        finished = np.flatnonzero(done)
+        if finished.size:
             final_obs = np.empty(self.num_envs, dtype=object)
-            for i, row in zip(finished.tolist(), obs[finished], strict=True):
-                final_obs[i] = row
+            final_obs[finished] = np.fromiter(obs[finished], dtype=object, count=finished.size)  # rows, as arrays
             infos["final_obs"] = final_obs
             infos["_final_obs"] = done
             infos["final_info"] = {}
@@ -208,7 +220,9 @@ class OrbitRaisingVectorEnv(VectorEnv):
                 raise ValueError(
                     f"actions of shape {a.shape} and dtype {a.dtype} are invalid; allowed: integers of shape ({n},)"
                 )
-            if a.min() < 0 or a.max() >= self._burn_sizes.size:
+            # One reduction: viewed as unsigned, negative actions are huge.
+            unsigned = a if a.dtype.kind == "u" else a.view(f"u{a.dtype.itemsize}")
+            if unsigned.max() >= self._burn_sizes.size:
                 bad = (a < 0) | (a >= self._burn_sizes.size)
                 raise ValueError(
                     f"action {a[bad][0].item()!r} is invalid; allowed: integers in [0, {self._burn_sizes.size - 1}]"
@@ -239,7 +253,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
             dv_out[idx] = dv
             self._mass_kg[idx] = mass_kg
             self._update_satellite(idx)
-            self._set_point(idx, universal_curves().locate(self._perigee_m[idx], apogee_m))
+            self._set_point(idx, self._perigee_m[idx], apogee_m)
         return idx
 
     def _start(self, idx: NDArray[np.intp], options: dict[str, Any] | None) -> None:
@@ -257,7 +271,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._update_satellite(idx)
         perigee_m = np.broadcast_to(np.asarray(start["perigee_km"]) * 1e3, idx.shape)
         apogee_m = np.broadcast_to(np.asarray(start["apogee_km"]) * 1e3, idx.shape)
-        self._set_point(idx, universal_curves().locate(perigee_m, apogee_m))
+        self._set_point(idx, perigee_m, apogee_m)
 
     def _restart(self, idx: NDArray[np.intp]) -> NDArray[np.float32]:
         """Automatic reset of ``idx``: copy fresh missions from the pool; return their observations.
@@ -271,29 +285,27 @@ class OrbitRaisingVectorEnv(VectorEnv):
             self._fill_pool()
         take = slice(self._pool_next, self._pool_next + idx.size)
         self._pool_next += idx.size
-        for name, array in self._pool.items():
-            getattr(self, name)[idx] = array[take]
+        self._state[:, idx] = self._pool[:, take]
         return self._pool_obs[take]
 
     def _fill_pool(self) -> None:
         """Draw ``num_envs`` fresh missions into the pool (the state arrays of a restart)."""
-        saved = {name: getattr(self, name).copy() for name in self._STATE}
+        saved = self._state.copy()
         everyone = np.arange(self.num_envs)
         self._start(everyone, None)
-        self._pool = {name: getattr(self, name).copy() for name in self._STATE}
+        self._pool = self._state.copy()
         zeros = np.zeros(self.num_envs)
         self._pool_obs = self._observe_subset(everyone, zeros, zeros)
-        for name, array in saved.items():
-            setattr(self, name, array)
+        self._state[...] = saved
         self._pool_next = 0
 
     def _update_satellite(self, idx: NDArray[np.intp]) -> None:
         """Recompute what depends on the mass for ``idx``: delta-v left and g c s."""
         mass = self._mass_kg[idx]
         self._dv_left_m_s[idx] = np.maximum(delta_v_left_m_s(mass, self._dry_mass_kg[idx], self._exhaust_m_s[idx]), 0.0)
-        nominal = nu_per_revolution(self._drag_area_m2[idx] / mass, self.density.nominal_scale)
-        self._nominal_w_per_day[idx] = nominal * SECONDS_PER_DAY
-        self._update_rates(idx)
+        drag_parameter = self._drag_area_m2[idx] / mass
+        self._nominal_w_per_day[idx] = nu_per_revolution(drag_parameter, self.density.nominal_scale * SECONDS_PER_DAY)
+        self._update_rates(idx, drag_parameter)
 
     def _density_now(self, idx: NDArray[np.intp] | slice) -> FloatArray:
         base = self._density_base[idx]
@@ -307,20 +319,20 @@ class OrbitRaisingVectorEnv(VectorEnv):
             self._time_days[idx],
         )
 
-    def _update_rates(self, idx: NDArray[np.intp] | slice) -> None:
+    def _update_rates(self, idx: NDArray[np.intp] | slice, drag_parameter: FloatArray | None = None) -> None:
         """Set g c s per revolution of ``idx``, s the density scale now (held over the coming step)."""
         scale = self._density_now(idx)
         self._density_scale[idx] = scale
-        self._nu_per_rev[idx] = nu_per_revolution(self._drag_area_m2[idx] / self._mass_kg[idx], scale)
+        if drag_parameter is None:
+            drag_parameter = self._drag_area_m2[idx] / self._mass_kg[idx]
+        self._nu_per_rev[idx] = nu_per_revolution(drag_parameter, scale)
 
-    def _set_point(self, idx: NDArray[np.intp], point: CurvePoint) -> None:
-        """Take freshly located orbits; heights and mean period from ``at`` (see the single env's)."""
+    def _set_point(self, idx: NDArray[np.intp], perigee_m: FloatArray, apogee_m: FloatArray) -> None:
+        """Locate new orbits of ``idx`` (start or burn); heights as the curves give them (see the single env's)."""
+        point, self._perigee_m[idx], self._apogee_m[idx] = universal_curves().locate_heights(perigee_m, apogee_m)
         self._label[idx] = point.label
         self._tau[idx] = point.tau
-        perigee_m, apogee_m, period_s = universal_curves().at(point.label, point.tau)
-        self._period[idx] = period_s
-        self._perigee_m[idx] = perigee_m
-        self._apogee_m[idx] = apogee_m
+        self._period[idx] = point.mean_period_s
 
     def _observe(
         self, weighted_s: FloatArray, perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
@@ -331,7 +343,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
                 self._perigee_m,
                 self._apogee_m,
                 self._dv_left_m_s,
-                self._steps / self.config.horizon_steps,
+                self._steps * (1.0 / self.config.horizon_steps),
                 weighted_s / self._nominal_w_per_day,
                 apogee_drop_m,
                 perigee_drop_m,
@@ -347,7 +359,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
                 self._perigee_m[idx],
                 self._apogee_m[idx],
                 self._dv_left_m_s[idx],
-                self._steps[idx] / self.config.horizon_steps,
+                self._steps[idx] * (1.0 / self.config.horizon_steps),
                 weighted_s / self._nominal_w_per_day[idx],
                 apogee_drop_m,
                 perigee_drop_m,
