@@ -263,7 +263,7 @@ def main() -> None:
 def sensitivity(rows: list[Row]) -> None:
     """How far each prediction moves with its most uncertain inputs (the model's C_D, the heights, the masses)."""
     activity = read_solar_csv(SOLAR_CSV)
-    print(f"{'case':12} {'C_D +5%':>8} {'h -5 km':>8} {'h +5 km':>8}   (change of predicted / observed - 1)")
+    print(f"{'case':12} {'C_D +5%':>8} {'h -5 km':>8} {'h +5 km':>8}   (predicted / observed - 1 with that change)")
     for case, row in zip(CASES, rows, strict=True):
         changes = [
             predict(case, activity, row.drag_coefficient * 1.05),
