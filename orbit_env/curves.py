@@ -133,6 +133,65 @@ class _Grid:
             out.append(value)
         return out
 
+    def segments(self, x: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Per point, the y cell it lies in and, per table, the line the interpolant follows across it at x.
+
+        At a fixed x the bilinear form is linear in y within a cell:
+        f = (c0 + c1 tx) + (c2 + c3 tx) ty. Returns a (1 + 2k, n) array: the cell
+        index j (as a float), then the k bases c0 + c1 tx, then the k slopes
+        c2 + c3 tx; and ty, where y is in its cell. :meth:`along` evaluates them.
+        """
+        fx = np.asarray(np.multiply(x, self.x_scale))
+        fx -= self.x_offset
+        np.maximum(fx, 0.0, out=fx)
+        np.minimum(fx, self.x_top, out=fx)
+        fy = np.asarray(np.multiply(y, self.y_scale))
+        if self.y_offset:
+            fy -= self.y_offset
+        np.maximum(fy, 0.0, out=fy)
+        np.minimum(fy, self.y_top, out=fy)
+        i = fx.astype(np.intp)
+        tx = fx - i
+        j = fy.astype(np.intp)
+        ty = fy - j
+        i *= self.ny
+        cell = self.cells.take(i + j, axis=0)
+        out = np.empty((1 + 2 * self.k, *tx.shape))
+        out[0] = j
+        for m in range(self.k):
+            np.multiply(cell[..., m, 1], tx, out=out[1 + m])
+            out[1 + m] += cell[..., m, 0]
+            np.multiply(cell[..., m, 3], tx, out=out[1 + self.k + m])
+            out[1 + self.k + m] += cell[..., m, 2]
+        return out, ty
+
+    def along(self, segments: FloatArray, ty: FloatArray) -> list[FloatArray]:
+        """The k tables at ``ty`` of the way across each point's cell (see :meth:`segments`)."""
+        out = []
+        for m in range(self.k):
+            value = segments[1 + self.k + m] * ty
+            value += segments[1 + m]
+            out.append(value)
+        return out
+
+    def on_segments(self, segments: FloatArray, x: FloatArray, y: FloatArray) -> list[FloatArray]:
+        """:meth:`values` at (x, y) for points whose x has not changed since ``segments`` was made.
+
+        Points whose y has left its cell get a fresh segment, written into
+        ``segments`` in place. Equal to :meth:`values` up to round-off (the same
+        bilinear form, its terms grouped differently).
+        """
+        fy = np.asarray(np.multiply(y, self.y_scale))
+        if self.y_offset:
+            fy -= self.y_offset
+        np.maximum(fy, 0.0, out=fy)
+        np.minimum(fy, self.y_top, out=fy)
+        ty = fy - segments[0]
+        moved = np.flatnonzero((ty < 0.0) | (ty > 1.0))
+        if moved.size:
+            segments[:, moved], ty[moved] = self.segments(x[moved], y[moved])
+        return self.along(segments, ty)
+
     def values_scalar(self, x: float, y: float) -> list[float]:
         """:meth:`values` for one point, in plain floats.
 
@@ -151,6 +210,15 @@ class _Grid:
         return [
             item(row, m, 1) * tx + item(row, m, 0) + item(row, m, 2) * ty + item(row, m, 3) * txy for m in range(self.k)
         ]
+
+
+def _heights(mu: FloatArray, b0: FloatArray, b1: FloatArray, q: FloatArray) -> tuple[FloatArray, ...]:
+    """Table B's values (perigee height, ln e - mu, q) at labels mu into perigee and apogee heights [m] and q."""
+    hp = np.maximum(b0, REENTRY_ALTITUDE_M)
+    e = np.exp(b1 + mu)
+    rp = EARTH_RADIUS_M + hp
+    # ra = rp (1 + e) / (1 - e) = 2 rp / (1 - e) - rp
+    return hp, (rp + rp) / (1.0 - e) - rp - EARTH_RADIUS_M, q
 
 
 @dataclass(frozen=True)
@@ -341,6 +409,15 @@ class UniversalCurves:
         perigee, apogee, q = self.at(label, tau)
         return CurvePoint(label=label, tau=tau, mean_period_s=q), perigee, apogee
 
+    def locate_segments(
+        self, perigee_m: ArrayLike, apogee_m: ArrayLike
+    ) -> tuple[CurvePoint, FloatArray, FloatArray, FloatArray]:
+        """:meth:`locate_heights` for arrays, and the located orbits' :meth:`segments`."""
+        label, tau = self._label_tau(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
+        segments, ty = self._table_b.segments(label, tau)
+        perigee, apogee, q = _heights(label, *self._table_b.along(segments, ty))
+        return CurvePoint(label=label, tau=tau, mean_period_s=q), perigee, apogee, segments
+
     def _label_tau(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """(label, tau) of orbits, from table A."""
         if isinstance(perigee_m, float) and isinstance(apogee_m, float):
@@ -372,11 +449,19 @@ class UniversalCurves:
             rp_s = EARTH_RADIUS_M + hp_s
             return hp_s, rp_s * (1.0 + e_s) / (1.0 - e_s) - EARTH_RADIUS_M, b2
         mu = np.asarray(label, dtype=np.float64)
-        b0, b1, b2 = self._table_b.values(mu, tau)
-        hp = np.maximum(b0, REENTRY_ALTITUDE_M)
-        e = np.exp(b1 + mu)
-        rp = EARTH_RADIUS_M + hp
-        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, b2
+        return _heights(mu, *self._table_b.values(mu, tau))
+
+    def segments(self, label: FloatArray, tau: FloatArray) -> FloatArray:
+        """Where orbits at (label, tau) are on table B, for :meth:`advance_heights` to keep between steps.
+
+        An orbit coasts along one curve (fixed label) and its tau falls by a small
+        part of a table cell per step (in the env's defaults 4-7% of satellites
+        change cell in a step), so keeping each orbit's cell and the lines the
+        three values follow across it (a (7, n) array) replaces a gather per
+        orbit and step by two operations per value. Make them anew for orbits
+        whose label changed (a burn); cell changes are handled by ``advance_heights``.
+        """
+        return self._table_b.segments(np.asarray(label, dtype=np.float64), np.asarray(tau, dtype=np.float64))[0]
 
     def _after(self, point: CurvePoint, dnu: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The (nu, tau) reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
@@ -392,15 +477,22 @@ class UniversalCurves:
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
         return self._with_period(label, tau)._known_nu(nu)
 
-    def advance_heights(self, point: CurvePoint, dnu: ArrayLike) -> tuple[CurvePoint, FloatArray, FloatArray]:
+    def advance_heights(
+        self, point: CurvePoint, dnu: ArrayLike, segments: FloatArray | None = None
+    ) -> tuple[CurvePoint, FloatArray, FloatArray]:
         """:meth:`advance`, and the perigee and apogee heights [m] of the new point.
 
         The same as ``advance`` followed by ``at``, in one interpolation: what a
-        simulator stepping many orbits and observing their heights needs.
+        simulator stepping many orbits and observing their heights needs. With
+        ``segments`` (from :meth:`segments` or :meth:`locate_segments`, for these
+        orbits' labels) the interpolation uses and updates them in place.
         """
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
-        perigee_m, apogee_m, q = self.at(label, tau)
+        if segments is None:
+            perigee_m, apogee_m, q = self.at(label, tau)
+        else:
+            perigee_m, apogee_m, q = _heights(label, *self._table_b.on_segments(segments, label, tau))
         return CurvePoint(label=label, tau=tau, mean_period_s=q)._known_nu(nu), perigee_m, apogee_m
 
 
@@ -408,7 +500,7 @@ def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike 
     """Universal variable one revolution is worth: dnu/dN = g c s (Eq. 4.1)."""
     if isinstance(drag_parameter_m2_kg, float) and isinstance(density_scale, float):
         return G0_M_S2 * float(drag_parameter_m2_kg) * float(density_scale)
-    return G0_M_S2 * np.asarray(drag_parameter_m2_kg, dtype=np.float64) * np.asarray(density_scale, dtype=np.float64)
+    return G0_M_S2 * np.multiply(drag_parameter_m2_kg, density_scale, dtype=np.float64)
 
 
 @lru_cache(maxsize=8)

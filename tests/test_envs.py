@@ -752,9 +752,9 @@ def test_vector_env_uses_the_curves_not_a_copy(monkeypatch):
     calls = []
     original = type(universal_curves()).advance_heights
 
-    def spy(self, point, dnu):
+    def spy(self, point, dnu, segments=None):
         calls.append(np.size(dnu))
-        return original(self, point, dnu)
+        return original(self, point, dnu, segments)
 
     monkeypatch.setattr(type(universal_curves()), "advance_heights", spy)
     vec = OrbitRaisingVectorEnv(32)
@@ -772,3 +772,28 @@ def test_observation_bounds_cover_the_curves():
     perigee, apogee, _ = universal_curves().at(np.linspace(labels[0], labels[-1], 2000), np.full(2000, 30.0))
     assert perigee.max() <= OBS_HIGH[0] * 1e6
     assert apogee.max() <= OBS_HIGH[1] * 1e6
+
+
+def test_segments_follow_the_interpolation_across_cells():
+    """Kept segments give table B's bilinear values (to round-off) while tau falls through many cells."""
+    curves = universal_curves()
+    rng = np.random.default_rng(3)
+    perigee = rng.uniform(150e3, 900e3, 500)
+    apogee = perigee + rng.uniform(0.0, 2500e3, 500)
+    point, perigee_m, apogee_m, segments = curves.locate_segments(perigee, apogee)
+    np.testing.assert_allclose(curves.at(point.label, point.tau)[:2], (perigee_m, apogee_m), rtol=1e-12)
+    cells_moved = 0
+    step = point.nu / 30.0
+    for _ in range(40):  # to re-entry and past it (tau clamped at 0)
+        before = segments[0].copy()
+        dnu = point.nu * rng.uniform(0.05, 0.3, 500) + step
+        moved, perigee_m, apogee_m = curves.advance_heights(point, dnu, segments)
+        plain, plain_perigee, plain_apogee = curves.advance_heights(point, dnu)
+        np.testing.assert_allclose(moved.mean_period_s, plain.mean_period_s, rtol=1e-12)
+        np.testing.assert_allclose(perigee_m, plain_perigee, rtol=1e-12)
+        np.testing.assert_allclose(apogee_m, plain_apogee, rtol=1e-12)
+        np.testing.assert_array_equal(segments, curves.segments(moved.label, moved.tau))  # refreshed where moved
+        cells_moved += int(np.count_nonzero(segments[0] != before))
+        point = moved
+    assert cells_moved > 1000  # the test did cross cells
+    assert np.all(point.tau == 0.0)

@@ -345,7 +345,7 @@ def perigee_burn(
         dv = np.where(over, np.maximum(np.minimum(dv, dv_cap), 0.0), dv)
         apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
     apogee_after = np.minimum(apogee_after, CURVES_MAX_APOGEE_M)
-    mass_after = mass_kg * np.exp(-dv / exhaust_velocity_m_s)
+    mass_after = mass_kg / np.exp(dv / exhaust_velocity_m_s)
     # Emptying the tank leaves exactly the dry mass (the exponential rounds either way).
     mass_after = np.where(dv >= dv_fuel, dry_mass_kg, np.maximum(mass_after, dry_mass_kg))
     return dv, apogee_after, mass_after
@@ -361,18 +361,26 @@ class Coast(NamedTuple):
     weighted_s: FloatArray
 
 
-def coast(curves: UniversalCurves, point: CurvePoint, revolutions: ArrayLike, nu_per_rev: ArrayLike) -> Coast:
+def coast(
+    curves: UniversalCurves,
+    point: CurvePoint,
+    revolutions: ArrayLike,
+    nu_per_rev: ArrayLike,
+    segments: FloatArray | None = None,
+) -> Coast:
     """Coast K revolutions along the universal curves.
 
     K revolutions move nu by K g c s (Eq. 4.1). The time is the drop of W = Int P dnu
     over g c s; at re-entry the curves clamp nu, and so W, at 0, so the same formula
-    gives the exact fraction of the step lived before re-entry.
+    gives the exact fraction of the step lived before re-entry. ``segments``: the
+    orbits' places on the curves' table, kept between steps by a vector simulator
+    (``UniversalCurves.segments``), updated in place.
 
     Returns:
         The new point, its perigee and apogee heights [m], the days lived and the
         new point's W [s m^3/(kg s^2)].
     """
-    after, perigee_m, apogee_m = curves.advance_heights(point, revolutions * nu_per_rev)
+    after, perigee_m, apogee_m = curves.advance_heights(point, revolutions * nu_per_rev, segments)
     weighted_s = after.weighted_s
     days = (point.weighted_s - weighted_s) / (nu_per_rev * SECONDS_PER_DAY)
     return Coast(after, perigee_m, apogee_m, days, weighted_s)

@@ -35,6 +35,7 @@ from orbit_env.envs.orbit_raising import (
 )
 
 FloatArray = NDArray[np.float64]
+_SEGMENT_ROWS = 7  # cell, then the base and the slope of each of the curves' three values
 
 
 class OrbitRaisingVectorEnv(VectorEnv):
@@ -70,6 +71,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
     _STATE = (
         "_label",
         "_tau",
+        "_nu",
         "_period",
         "_perigee_m",
         "_apogee_m",
@@ -118,7 +120,8 @@ class OrbitRaisingVectorEnv(VectorEnv):
         # Curve coordinates (label, tau, mean period), heights, the satellites, the clock (steps: whole
         # numbers, exact in float64). _nominal_w_per_day: g c s0 x 1 day with the nominal density; W over
         # it is the predicted lifetime [days].
-        self._state = np.zeros((len(self._STATE), self.num_envs))
+        # Below them, each satellite's place on the curves' table (UniversalCurves.segments).
+        self._state = np.zeros((len(self._STATE) + _SEGMENT_ROWS, self.num_envs))
         self._bind_state()
         self._has_state = False
         self._pool = np.zeros((len(self._STATE), 0))
@@ -128,12 +131,13 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._everyone_mask.flags.writeable = False
 
     def _bind_state(self) -> None:
-        for name, row in zip(self._STATE, self._state, strict=True):
+        for name, row in zip(self._STATE, self._state, strict=False):
             setattr(self, name, row)
+        self._segments = self._state[len(self._STATE) :]
 
     def __getstate__(self) -> dict[str, Any]:
         """Pickle the state array once, not its row views (which would unpickle as copies)."""
-        return {key: value for key, value in self.__dict__.items() if key not in self._STATE}
+        return {key: value for key, value in self.__dict__.items() if key not in (*self._STATE, "_segments")}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
@@ -172,22 +176,24 @@ class OrbitRaisingVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before step()")
         requested = self._requested_dv(actions)
         dv = np.zeros(self.num_envs)
-        burning = np.flatnonzero((requested > 0.0) & (self._mass_kg > self._dry_mass_kg))
+        burning = np.flatnonzero(np.minimum(requested, self._dv_left_m_s))  # asked to burn, and able to
         if burning.size:
             burning = self._burn(burning, requested[burning], dv)
         if self.density.varies:
             self._update_rates(slice(None))
         after, perigee_m, apogee_m, days, weighted_s = coast(
             universal_curves(),
-            CurvePoint(self._label, self._tau, self._period),
+            CurvePoint(self._label, self._tau, self._period)._known_nu(self._nu),  # no expm1 of 4096 taus
             self.config.revolutions_per_step,
             self._nu_per_rev,
+            self._segments,
         )
         perigee_drop_m = self._perigee_m - perigee_m
         apogee_drop_m = self._apogee_m - apogee_m
         self._perigee_m[...] = perigee_m
         self._apogee_m[...] = apogee_m
         self._tau[...] = after.tau
+        self._nu[...] = after.nu
         self._period[...] = after.mean_period_s
         self._time_days += days
         self._steps += 1
@@ -310,7 +316,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
     def _density_now(self, idx: NDArray[np.intp] | slice) -> FloatArray:
         base = self._density_base[idx]
         if not self.density.varies:
-            return base.copy()
+            return base
         return density_scale_at(
             base,
             self.density.cycle_amplitude,
@@ -329,9 +335,12 @@ class OrbitRaisingVectorEnv(VectorEnv):
 
     def _set_point(self, idx: NDArray[np.intp], perigee_m: FloatArray, apogee_m: FloatArray) -> None:
         """Locate new orbits of ``idx`` (start or burn); heights as the curves give them (see the single env's)."""
-        point, self._perigee_m[idx], self._apogee_m[idx] = universal_curves().locate_heights(perigee_m, apogee_m)
+        point, self._perigee_m[idx], self._apogee_m[idx], self._segments[:, idx] = universal_curves().locate_segments(
+            perigee_m, apogee_m
+        )
         self._label[idx] = point.label
         self._tau[idx] = point.tau
+        self._nu[idx] = point.nu
         self._period[idx] = point.mean_period_s
 
     def _observe(
@@ -353,7 +362,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
     def _observe_subset(
         self, idx: NDArray[np.intp], perigee_drop_m: FloatArray, apogee_drop_m: FloatArray
     ) -> NDArray[np.float32]:
-        weighted_s = CurvePoint(self._label[idx], self._tau[idx], self._period[idx]).weighted_s
+        weighted_s = self._period[idx] * self._nu[idx]
         return _stack(
             observation(
                 self._perigee_m[idx],
