@@ -104,7 +104,11 @@ def test_panel_sum_of_a_box_flown_nose_first():
     ratio=st.floats(0.0, 1.0),
     alpha=st.floats(0.0, 1.0),
 )
-def test_plate_drag_is_finite_and_non_negative(gamma, s, ratio, alpha):
+def test_plate_drag_is_finite_and_a_thin_plate_is_pushed_downstream(gamma, s, ratio, alpha):
     cd = float(plate_drag_coefficient(gamma, s, ratio, alpha))
     assert math.isfinite(cd)
-    assert cd >= -1e-12
+    if gamma >= 0.0:
+        assert cd >= 0.0
+    # A wake face alone can be pushed upstream a little (thermal molecules overtaking it at
+    # low S), but a thin plate's two faces together always have drag.
+    assert cd + float(plate_drag_coefficient(-gamma, s, ratio, alpha)) >= 0.0
