@@ -215,10 +215,16 @@ class _Grid:
 def _heights(mu: FloatArray, b0: FloatArray, b1: FloatArray, q: FloatArray) -> tuple[FloatArray, ...]:
     """Table B's values (perigee height, ln e - mu, q) at labels mu into perigee and apogee heights [m] and q."""
     hp = np.maximum(b0, REENTRY_ALTITUDE_M)
-    e = np.exp(b1 + mu)
-    rp = EARTH_RADIUS_M + hp
-    # ra = rp (1 + e) / (1 - e) = 2 rp / (1 - e) - rp
-    return hp, (rp + rp) / (1.0 - e) - rp - EARTH_RADIUS_M, q
+    one_minus_e = np.asarray(b1 + mu)  # an array even for 0-d input (in-place below)
+    np.exp(one_minus_e, out=one_minus_e)
+    np.subtract(1.0, one_minus_e, out=one_minus_e)
+    rp = hp + EARTH_RADIUS_M
+    # ra = rp (1 + e) / (1 - e) = 2 rp / (1 - e) - rp, in place (a batch costs numpy calls and allocations)
+    apogee = rp + rp
+    apogee /= one_minus_e
+    apogee -= rp
+    apogee -= EARTH_RADIUS_M
+    return hp, apogee, q
 
 
 @dataclass(frozen=True)
