@@ -12,19 +12,20 @@ the curves), and coasting (action 0, what a satellite does most of its life).
 Each measurement is the best of ``--repeats`` runs, taken in turn with its
 reference so that both see the same machine load.
 
-Where the vector env stands (2-core machine, numpy 2.4): coasting about 0.6x
-CartPoleVectorEnv, with random actions about 0.4x. A coasting step is one
-interpolation of the universal curves for all satellites (advance_heights: three
-tables, twelve gathers) plus the reward and the observation, about 60 numpy calls
-on 4096 floats. A step in which any satellite burns adds, for the burning subset,
-the vis-viva burn and the rocket equation, ``locate`` on table A and ``at`` on
-table B: about 150 more numpy calls, whose fixed cost (about 1 us each) does not
-shrink with the subset, so ~150 us per step whether 5 or 500 satellites burn.
-CartPole has no counterpart of that. At 4096 envs some satellite burns in nearly
-every step under any policy that burns at all, so the random-action ratio is the
-one that matters for training.
+Where the vector env stands (2-core machine, numpy 2.4, steady state after the
+warm-up): coasting about 0.8x CartPoleVectorEnv, random actions about 0.5x. A
+coasting step advances every satellite along its curve with two operations per
+value on the table cell it is in (``UniversalCurves.segments``: 4-7% of satellites
+enter a new cell per step and get a fresh one), converts to heights, and builds the
+reward and the observation: about 60 numpy calls on 4096 floats. Under random actions
+about 100 satellites burn per step (the ones that restarted lately, tanks full):
+the vis-viva burn, the rocket equation, ``locate`` on table A and a new segment on
+table B for that subset, about 150 numpy calls whose fixed cost (about 0.6 us each)
+hardly shrinks with the subset. CartPole has no counterpart of that, and at 4096
+envs some satellite burns in every step under any policy that burns at all, so the
+random-action ratio is the one that matters for training.
 
-Run: ``python benchmarks/bench_env.py [--steps N] [--vector-steps N] [--repeats R]``.
+Run: ``python benchmarks/bench_env.py [--steps N] [--vector-steps N] [--repeats R] [--warmup W]``.
 """
 
 from __future__ import annotations
@@ -55,11 +56,11 @@ def time_single(env: gym.Env, actions: list[int]) -> float:
     return time.perf_counter() - start
 
 
-def time_vector(env: gym.vector.VectorEnv, actions: list[np.ndarray]) -> float:
-    """Seconds for ``len(actions)`` batched steps of a vector env."""
+def time_vector(env: gym.vector.VectorEnv, actions: list[np.ndarray], warmup: int) -> float:
+    """Seconds for ``len(actions)`` batched steps of a vector env, after ``warmup`` untimed ones."""
     env.reset(seed=0)
-    for action in actions[:10]:  # warm-up: first restarts, caches
-        env.step(action)
+    for k in range(warmup):  # to the steady state: missions ending and restarting every step
+        env.step(actions[k % len(actions)])
     step = env.step
     start = time.perf_counter()
     for action in actions:
@@ -81,6 +82,13 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=100_000, help="single-env steps per run")
     parser.add_argument("--vector-steps", type=int, default=300, help="vector-env steps per run")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument(
+        "--warmup",
+        type=int,
+        default=400,
+        help="untimed vector steps first: after about 300 steps the first missions end and restarting "
+        "satellites (full tanks) burn every step, the state training runs in",
+    )
     args = parser.parse_args()
     register_envs()
     rng = np.random.default_rng(0)
@@ -110,9 +118,9 @@ def main() -> None:
     coast_vec_actions = [np.zeros(NUM_ENVS, dtype=np.int64)] * m
     t_cart, t_orbit, t_coast = best_of(
         args.repeats,
-        lambda: time_vector(cart_vec, cart_vec_actions),
-        lambda: time_vector(orbit_vec, orbit_vec_actions),
-        lambda: time_vector(orbit_vec, coast_vec_actions),
+        lambda: time_vector(cart_vec, cart_vec_actions, args.warmup),
+        lambda: time_vector(orbit_vec, orbit_vec_actions, args.warmup),
+        lambda: time_vector(orbit_vec, coast_vec_actions, args.warmup),
     )
     per = m * NUM_ENVS
     print(f"vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}")

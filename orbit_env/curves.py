@@ -184,8 +184,7 @@ class _Grid:
         fy = np.asarray(np.multiply(y, self.y_scale))
         if self.y_offset:
             fy -= self.y_offset
-        np.maximum(fy, 0.0, out=fy)
-        np.minimum(fy, self.y_top, out=fy)
+        # No clamps: a y beyond the grid is outside its cell, and :meth:`segments` clamps it.
         ty = fy - segments[0]
         moved = np.flatnonzero((ty < 0.0) | (ty > 1.0))
         if moved.size:
