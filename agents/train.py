@@ -17,6 +17,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from agents.shaping import SHAPINGS
+
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
 #: The shipped model, trained by ``orbit-env train`` with :data:`DEFAULT_CONFIG`.
@@ -70,6 +72,9 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     schedule = config.get("learning_rate_schedule", "constant")
     if schedule not in ("constant", "linear"):
         raise ValueError(f"learning_rate_schedule={schedule!r} is invalid; allowed: constant, linear")
+    shaping = config.get("shaping", "none")
+    if shaping not in SHAPINGS:
+        raise ValueError(f"shaping={shaping!r} is invalid; allowed: {', '.join(SHAPINGS)}")
     if int(config["total_timesteps"]) <= 0 or int(config["num_envs"]) <= 0:
         raise ValueError("total_timesteps and num_envs must be positive integers")
     return config
@@ -117,6 +122,10 @@ def train(
     venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed)
     if not config.get("bootstrap_at_horizon", True):
         venv = _mission_end_is_terminal(venv)
+    if config.get("shaping", "none") == "never_burn_value":
+        from agents.shaping import never_burn_value_shaping
+
+        venv = never_burn_value_shaping(venv)  # before VecNormalize: it scales the shaped reward
     if config.get("normalize", {}).get("reward", False):
         venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=float(config["ppo"]["gamma"]))
     activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
