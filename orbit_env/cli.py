@@ -121,9 +121,12 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         raise ValueError("--out goes with --batch (a single lifetime prints; --trajectory writes its history)")
     if args.perigee is None or args.apogee is None:
         raise ValueError("give --perigee and --apogee (or --batch CSV)")
+    # Default method: the averaged ODE (the reference) for a fixed atmosphere; for activity that changes
+    # in time, the time-stepped curves (the averaged reference then rebuilds NRLMSIS every day: minutes).
+    method = args.method or ("curves" if scenario.time_varying else "averaged")
     options: dict[str, Any] = {
         "satellite": satellite,
-        "method": args.method,
+        "method": method,
         "rotating_atmosphere": args.rotating_atmosphere,
         "inclination_deg": args.inclination,
     }
@@ -200,7 +203,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
     for name in ("trajectory", "plot", "json"):
         if _given(args, name):
             raise ValueError(f"{_flag(name)} applies to a single lifetime, not to --batch")
-    if args.method != "averaged":
+    if args.method is not None:
         raise ValueError("--batch always uses the universal curves; do not give --method")
     start = time.perf_counter()
     rows, hp, ha, c, inc, status = read_batch(
@@ -340,7 +343,13 @@ def build_parser() -> argparse.ArgumentParser:
     life.add_argument("--perigee", type=float, metavar="KM", help="perigee height [km]")
     life.add_argument("--apogee", type=float, metavar="KM", help="apogee height [km]")
     _add_satellite_options(life)
-    life.add_argument("--method", choices=METHODS, default="averaged", help="averaged ODE, universal curves, or direct")
+    life.add_argument(
+        "--method",
+        choices=METHODS,
+        default=None,
+        help="averaged ODE, universal curves, or direct (default: averaged; curves when the solar activity "
+        "changes in time, where the averaged reference takes minutes)",
+    )
     _add_atmosphere_options(life)
     life.add_argument("--rule", type=float, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
     life.add_argument("--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.batch)")
