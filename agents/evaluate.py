@@ -133,8 +133,30 @@ def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
     return {name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()}
 
 
-def format_table(env_id: str, episodes: int, seed: int, table: Mapping[str, Mapping[str, float | None]]) -> str:
-    """The evaluation as a text table for people."""
+def paired_difference(results: Mapping[str, Episodes], name: str = "ppo") -> dict[str, Any] | None:
+    """``name``'s return minus the best hand-coded policy's, episode by episode (None without them).
+
+    Both policies meet the same start states, so the per-episode difference has a
+    much smaller spread than either return: its mean and standard error say
+    whether a small lead is more than the luck of these episodes.
+    """
+    baselines = [b for b in HAND_CODED if b in results]
+    if name not in results or not baselines:
+        return None
+    best = max(baselines, key=lambda b: results[b].returns.mean())
+    diff = results[name].returns - results[best].returns
+    stderr = float(diff.std(ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else float("nan")
+    return {"policy": name, "baseline": best, "mean": float(diff.mean()), "stderr": stderr}
+
+
+def format_table(
+    env_id: str,
+    episodes: int,
+    seed: int,
+    table: Mapping[str, Mapping[str, float | None]],
+    paired: Mapping[str, Any] | None = None,
+) -> str:
+    """The evaluation as a text table for people (``paired``: from :func:`paired_difference`)."""
     lines = [
         f"{env_id}: {episodes} episodes (seed {seed})",
         f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
@@ -146,6 +168,11 @@ def format_table(env_id: str, episodes: int, seed: int, table: Mapping[str, Mapp
             f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
         )
     lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
+    if paired is not None:
+        lines.append(
+            f"{paired['policy']} - {paired['baseline']} on the same episodes: {paired['mean']:+.2f} +- "
+            f"{paired['stderr']:.2f} days (mean +- standard error)"
+        )
     return "\n".join(lines)
 
 

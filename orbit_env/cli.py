@@ -310,7 +310,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from agents.evaluate import all_policies, evaluate, format_table, plot_returns
+    from agents.evaluate import all_policies, evaluate, format_table, paired_difference, plot_returns
 
     def say(name: str) -> None:
         if not args.json:
@@ -320,10 +320,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
         plot_returns(results, args.env, args.plot)
+    paired = paired_difference(results)
     if args.json:
-        print(json.dumps({"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}))
+        out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}
+        if paired is not None:
+            out["paired_difference"] = paired
+        print(json.dumps(out))
     else:
-        print(format_table(args.env, args.episodes, args.seed, table))
+        print(format_table(args.env, args.episodes, args.seed, table, paired))
     return 0
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.evaluate import EVAL_SEED, hand_coded_policies, run_episodes, summarize
+from agents.evaluate import EVAL_SEED, Episodes, hand_coded_policies, paired_difference, run_episodes, summarize
 from agents.policies import AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
 from orbit_env.cli import main
 from orbit_env.envs.orbit_raising import OrbitRaisingConfig
@@ -43,6 +43,17 @@ def test_summary_capture_is_relative_to_never_and_dp(baseline_results):
     assert table["never"]["capture"] == pytest.approx(0.0)
     assert table["dp"]["capture"] == pytest.approx(1.0)
     assert set(table["never"]) == {"mean_return", "std_return", "mean_lifetime_days", "mean_dv_m_s", "capture"}
+
+
+def test_paired_difference_is_against_the_best_hand_coded_policy(baseline_results):
+    greedy = baseline_results["greedy"]
+    wobble = np.where(np.arange(greedy.returns.size) % 2 == 0, 1.0, -0.5)
+    fake = dict(baseline_results, ppo=Episodes(greedy.returns + wobble, greedy.lifetime_days, greedy.dv_m_s))
+    paired = paired_difference(fake)
+    assert paired["baseline"] == "greedy" and paired["policy"] == "ppo"
+    assert paired["mean"] == pytest.approx(wobble.mean())
+    assert paired["stderr"] == pytest.approx(wobble.std(ddof=1) / np.sqrt(wobble.size))
+    assert paired_difference(baseline_results) is None  # no ppo
 
 
 @pytest.mark.parametrize("cls", [NeverBurn, AllAtOnce, ApogeeThreshold, Greedy])
@@ -87,6 +98,7 @@ def test_evaluate_cli_json_without_dp(capsys):
     assert status == 0
     assert out["env"] == "OrbitRaising-v0" and out["episodes"] == 8
     assert {"never", "all_at_once", "apogee_threshold", "greedy", "ppo"} <= set(out["policies"])
+    assert out["paired_difference"]["policy"] == "ppo"
 
 
 @pytest.mark.parametrize(
