@@ -190,6 +190,45 @@ def test_seeded_vector_episodes_are_identical(env_id):
         np.testing.assert_array_equal(x, y)
 
 
+def test_reset_mask_restarts_only_the_masked_satellites():
+    # Gymnasium's reset(options={"reset_mask": mask}): masked missions start anew (other options
+    # pin them, arrays read at the masked places); the others keep their state and last observation.
+    env = make_vec("OrbitRaising-v0", 4)
+    env.reset(seed=3)
+    for _ in range(5):
+        obs, *_ = env.step(np.array([0, 1, 0, 2]))
+    before = env.unwrapped.state
+    mask = np.array([False, True, False, True])
+    new, _ = env.reset(
+        options={"reset_mask": mask, "perigee_km": np.array([0.0, 300.0, 0.0, 310.0]), "apogee_km": 500.0}
+    )
+    after = env.unwrapped.state
+    np.testing.assert_array_equal(new[~mask], obs[~mask])
+    for key in before:
+        np.testing.assert_array_equal(after[key][~mask], before[key][~mask])
+    # Heights as the curves give them back after locating (the env's convention): metres off.
+    np.testing.assert_allclose(after["perigee_m"][mask], [300e3, 310e3], rtol=1e-4)
+    np.testing.assert_allclose(after["apogee_m"][mask], 500e3, rtol=1e-4)
+    assert np.all(new[mask, 3] == 0.0) and np.all(new[mask, 2] > obs[mask, 2])  # clock 0, tank full again
+    # The restarted missions then step as fresh ones: same as a single env pinned to them.
+    single = make("OrbitRaising-v0")
+    first, _ = single.reset(seed=0, options={"perigee_km": 300.0, "apogee_km": 500.0})
+    np.testing.assert_allclose(new[1], first, rtol=1e-6, atol=1e-7)
+    stepped, reward, *_ = env.step(np.zeros(4, dtype=np.int64))
+    expected, reward_single, *_ = single.step(0)
+    np.testing.assert_allclose(stepped[1], expected, rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(reward[1], reward_single, rtol=1e-9)
+    for bad, message in (
+        (np.zeros(4, dtype=bool), "at least one True"),
+        (np.ones(3, dtype=bool), "shape"),
+        ([True, False, True, False], "numpy bool array"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            env.reset(options={"reset_mask": bad})
+    with pytest.raises(RuntimeError, match="first reset"):
+        make_vec("OrbitRaising-v0", 4).reset(options={"reset_mask": mask})
+
+
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_pickle_round_trip_continues_identically(env_id):
     env = make(env_id)

@@ -127,6 +127,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._has_state = False
         self._pool = np.zeros((len(self._STATE), 0))
         self._pool_obs = np.zeros((0, 7), dtype=np.float32)
+        self._last_obs = np.zeros((self.num_envs, 7), dtype=np.float32)  # for reset_mask
         self._pool_next = self.num_envs
         self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
         self._everyone_mask.flags.writeable = False
@@ -160,14 +161,50 @@ class OrbitRaisingVectorEnv(VectorEnv):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
-        """Start new missions in every sub-environment (options as the single env's, per env)."""
+        """Start new missions (options as the single env's, per env).
+
+        ``options["reset_mask"]``, a boolean array of shape (num_envs,) as in
+        Gymnasium's ``SyncVectorEnv``, restarts only the masked sub-environments;
+        the other rows of the returned observation are their last observations.
+        The other options then apply to the masked ones (arrays of shape
+        (num_envs,) are read at the masked places).
+        """
         super().reset(seed=seed)
-        everyone = np.arange(self.num_envs)
-        self._start(everyone, options)
-        self._has_state = True
-        self._pool_next = self.num_envs  # empty: the next restart draws a fresh pool
-        zeros = np.zeros(self.num_envs)
-        return self._observe_subset(everyone, zeros, zeros), {}
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if seed is not None:
+            self._pool_next = self.num_envs  # empty: the next restart draws from the new seed
+        if mask is None:
+            idx = np.arange(self.num_envs)
+            self._start(idx, options or None)
+            self._has_state = True
+            self._pool_next = self.num_envs
+            zeros = np.zeros(self.num_envs)
+            self._last_obs = self._observe_subset(idx, zeros, zeros)
+            return self._last_obs, {}
+        idx = self._masked(mask)
+        obs = self._last_obs.copy()
+        if options:
+            masked = {k: v[idx] if np.shape(v) == (self.num_envs,) else v for k, v in options.items()}
+            self._start(idx, masked)
+            zeros = np.zeros(idx.size)
+            obs[idx] = self._observe_subset(idx, zeros, zeros)
+        else:
+            obs[idx] = self._restart(idx)  # fresh draws, as an automatic reset's
+        self._last_obs = obs
+        return obs, {}
+
+    def _masked(self, mask: Any) -> NDArray[np.intp]:
+        """The sub-environments a ``reset_mask`` names; ValueError as Gymnasium's for a bad mask."""
+        if not self._has_state:
+            raise RuntimeError("reset_mask needs a first reset() of every sub-environment")
+        if not (isinstance(mask, np.ndarray) and mask.dtype == np.bool_ and mask.shape == (self.num_envs,)):
+            raise ValueError(
+                f"options['reset_mask']={mask!r} is invalid; allowed: a numpy bool array of shape ({self.num_envs},)"
+            )
+        if not mask.any():
+            raise ValueError("options['reset_mask'] must contain at least one True value")
+        return np.flatnonzero(mask)
 
     def step(
         self, actions: Any
@@ -216,6 +253,7 @@ class OrbitRaisingVectorEnv(VectorEnv):
             infos["final_info"] = {}
             infos["_final_info"] = done
             obs[finished] = self._restart(finished)
+        self._last_obs = obs
         return obs, reward, terminated, truncated, infos
 
     def _requested_dv(self, actions: Any) -> FloatArray:
