@@ -19,6 +19,27 @@ rounding (the coast moves nu by the same amount the potential's coast does), and
 a burn's is at once its gain in days within the mission minus the propellant's
 cost: the credit for a burn no longer has to travel back over hundreds of steps.
 Evaluation (``orbit-env evaluate``) always scores the unshaped environment.
+
+Ending decided episodes (``end_decided`` in the training config). Most of a mission
+holds no decision: the satellite already outlives the mission without another burn,
+or the tank is empty (93% of the steps of the shipped agent's episodes). From such a
+state coasting is optimal, so its shaped optimal value is 0 exactly:
+
+* with the tank empty nothing can be done;
+* if the satellite outlives the mission, every mission day is already earned and a
+  burn can add only through a longer orbital period (the reward counts the days of
+  K revolutions). That gain is at most K x steps left x max dP/dv per m/s, below
+  the propellant's cost for the configs this accepts
+  (:func:`burns_cannot_pay_once_the_mission_is_covered` checks it over the curves'
+  whole domain: 0.30 day per m/s against a cost of 0.4 for the default task).
+
+So a training episode may end, as terminal, after the step taken from a decided
+state, with the shaped reward r + Phi(s') - Phi(s): the return it is trained on is
+then the one an optimal continuation would earn, and the optimal policy is
+unchanged. The agent still acts, and learns to coast, in the first decided state of
+every episode; with ``end_decided`` = q < 1 each decided step ends the episode with
+probability q, so later ones are seen too. Batches then hold the decisions instead
+of the hundreds of steps of coasting after them.
 """
 
 from __future__ import annotations
@@ -28,8 +49,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
-from orbit_env.envs.orbit_raising import OrbitRaisingConfig, coast
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, SECONDS_PER_DAY
+from orbit_env.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M, CurvePoint, nu_per_revolution, universal_curves
+from orbit_env.envs.orbit_raising import Coast, OrbitRaisingConfig, coast
 
 FloatArray = NDArray[np.float64]
 
@@ -37,15 +59,15 @@ FloatArray = NDArray[np.float64]
 SHAPINGS = ("none", "never_burn_value")
 
 
-def never_burn_days(
+def coast_to_mission_end(
     config: OrbitRaisingConfig,
     label: FloatArray,
     tau: FloatArray,
     mass_kg: FloatArray,
     density_scale: FloatArray,
     steps_left: FloatArray,
-) -> FloatArray:
-    """Days each satellite still lives within the mission if it never burns again.
+) -> Coast:
+    """Coast each satellite, never burning again, to the end of the mission (or re-entry).
 
     Args:
         config: The environment's config (drag coefficient, area, revolutions per step).
@@ -56,7 +78,8 @@ def never_burn_days(
         steps_left: Steps left in the mission (0 at the horizon).
 
     Returns:
-        Phi(s) [days], 0 for re-entered satellites and at the horizon.
+        The coast: ``days`` lived within the mission, ``point.tau`` > 0 where the
+        satellite is still in orbit at the mission's end.
     """
     curves = universal_curves()
     label = np.asarray(label, dtype=np.float64)
@@ -66,51 +89,121 @@ def never_burn_days(
     drag_parameter = config.drag_coefficient * config.area_m2 / np.asarray(mass_kg, dtype=np.float64)
     nu_per_rev = nu_per_revolution(drag_parameter, np.asarray(density_scale, dtype=np.float64))
     revolutions = np.maximum(np.asarray(steps_left, dtype=np.float64), 0.0) * config.revolutions_per_step
-    return np.maximum(coast(curves, point, revolutions, nu_per_rev).days, 0.0)
+    return coast(curves, point, revolutions, nu_per_rev)
 
 
-def potential(env: Any, observations: NDArray[np.float32]) -> FloatArray:
-    """Phi of every satellite of an orbit-raising vector env, read from its public state.
+def outlook(env: Any, observations: NDArray[np.float32]) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """Phi and "decided" of every satellite of an orbit-raising vector env, from its public state.
 
-    The steps taken come from the observation's mission clock (steps / horizon,
-    exact in float32 for any horizon below 2^24 steps).
+    Decided: the tank is empty, or the satellite outlives the mission without
+    another burn (see the module). The steps taken come from the observation's
+    mission clock (steps / horizon, exact in float32 for any horizon below 2^24 steps).
     """
     config = env.config
     state = env.state
-    steps = np.rint(np.asarray(observations, dtype=np.float64)[:, 3] * config.horizon_steps)
-    return never_burn_days(
-        config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], config.horizon_steps - steps
+    obs = np.asarray(observations, dtype=np.float64)
+    steps_left = config.horizon_steps - np.rint(obs[:, 3] * config.horizon_steps)
+    end = coast_to_mission_end(
+        config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], steps_left
     )
+    decided = (end.point.tau > 0.0) | (obs[:, 2] <= 0.0)
+    return np.maximum(end.days, 0.0), decided
 
 
-def never_burn_value_shaping(venv: Any) -> Any:
-    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with :class:`NeverBurnValueShaping`."""
+def potential(env: Any, observations: NDArray[np.float32]) -> FloatArray:
+    """Phi of every satellite of an orbit-raising vector env (see :func:`outlook`)."""
+    return outlook(env, observations)[0]
+
+
+def period_gain_days_per_m_s(config: OrbitRaisingConfig) -> float:
+    """The most mission days a perigee burn can add per m/s by lengthening the period alone.
+
+    dP/dv at perigee is 3 P v_p a / mu (vis-viva and Kepler's third law); its
+    largest value over the curves' domain (perigee 100-1100 km, apogee up to
+    4000 km), times K revolutions for each of the mission's steps.
+    """
+    perigee_m = np.linspace(100e3, CURVES_MAX_PERIGEE_M, 101)[:, None]
+    apogee_m = np.maximum(np.linspace(100e3, CURVES_MAX_APOGEE_M, 391)[None, :], perigee_m)
+    rp, ra = EARTH_RADIUS_M + perigee_m, EARTH_RADIUS_M + apogee_m
+    a = 0.5 * (rp + ra)
+    period_s = 2.0 * np.pi * np.sqrt(a**3 / MU_EARTH_M3_S2)
+    v_p = np.sqrt(MU_EARTH_M3_S2 * (2.0 / rp - 1.0 / a))
+    dp_dv = 3.0 * period_s * v_p * a / MU_EARTH_M3_S2
+    return float(dp_dv.max()) * config.revolutions_per_step * config.horizon_steps / SECONDS_PER_DAY
+
+
+def burns_cannot_pay_once_the_mission_is_covered(config: OrbitRaisingConfig) -> bool:
+    """Whether coasting is optimal wherever the satellite outlives the mission (see the module)."""
+    return period_gain_days_per_m_s(config) < config.propellant_cost_per_m_s
+
+
+def never_burn_value_shaping(venv: Any, end_decided: float = 0.0, seed: int | None = None) -> Any:
+    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with :class:`NeverBurnValueShaping`.
+
+    Args:
+        venv: The SB3 view of an orbit-raising vector env (:mod:`orbit_env.envs.sb3`).
+        end_decided: Probability that a step from a decided state ends its episode
+            (0: never; see the module).
+        seed: Seed of those draws.
+
+    Raises:
+        ValueError: ``end_decided`` outside [0, 1], or > 0 where it would not be
+            exact: a drifting or unknown density, or burns that can pay by the period.
+    """
     from stable_baselines3.common.vec_env import VecEnvWrapper
+
+    env = venv.unwrapped.env  # the Gymnasium vector env under SB3VecEnv
+    if not 0.0 <= end_decided <= 1.0:
+        raise ValueError(f"end_decided={end_decided!r} is invalid; allowed: a probability in [0, 1]")
+    if end_decided > 0.0:
+        low, high = env.density.scale_range
+        if env.density.varies or low != high:
+            raise ValueError("end_decided needs a known, constant density: with another the mission is never covered")
+        if not burns_cannot_pay_once_the_mission_is_covered(env.config):
+            raise ValueError(
+                f"end_decided is not exact for this config: a burn may add {period_gain_days_per_m_s(env.config):.3f} "
+                f"mission days per m/s by the period, more than its cost {env.config.propellant_cost_per_m_s}"
+            )
 
     class NeverBurnValueShaping(VecEnvWrapper):
         """Reward r + Phi(s') - Phi(s), Phi(s') = 0 where the episode ended (see the module).
 
-        ``infos[i]["unshaped_reward"]`` keeps the environment's reward.
+        ``infos[i]["unshaped_reward"]`` keeps the environment's reward;
+        ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
         """
 
         def __init__(self, inner: Any) -> None:
             super().__init__(inner)
-            self.env = inner.unwrapped.env  # the Gymnasium vector env under SB3VecEnv
+            self.env = env
             self.phi = np.zeros(self.num_envs)
+            self.decided = np.zeros(self.num_envs, dtype=bool)
+            self.rng = np.random.default_rng(seed)
 
         def reset(self) -> Any:
             obs = self.venv.reset()
-            self.phi = potential(self.env, obs)
+            self.phi, self.decided = outlook(self.env, obs)
             return obs
 
         def step_wait(self) -> Any:
             obs, rewards, dones, infos = self.venv.step_wait()
             # Finished satellites have restarted: obs and state are the new episode's s_0.
-            phi_next = potential(self.env, obs)
+            phi_next, decided_next = outlook(self.env, obs)
             shaped = rewards + np.where(dones, 0.0, phi_next) - self.phi
             for info, reward in zip(infos, rewards, strict=True):
                 info["unshaped_reward"] = float(reward)
-            self.phi = phi_next
+            if end_decided > 0.0:
+                end = self.decided & ~dones & (self.rng.random(self.num_envs) < end_decided)
+                if end.any():
+                    # shaped already holds r + Phi(s') - Phi(s) there: the optimal continuation's value.
+                    dones = dones | end
+                    for i in np.flatnonzero(end):
+                        infos[i]["terminal_observation"] = obs[i].copy()
+                        infos[i]["decided_end"] = True
+                    obs, _ = self.env.reset(options={"reset_mask": end})
+                    phi_new, decided_new = outlook(self.env, obs)
+                    phi_next = np.where(end, phi_new, phi_next)
+                    decided_next = np.where(end, decided_new, decided_next)
+            self.phi, self.decided = phi_next, decided_next
             return obs, shaped.astype(np.float32), dones, infos
 
     return NeverBurnValueShaping(venv)

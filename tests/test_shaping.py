@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.shaping import never_burn_days, never_burn_value_shaping
+from agents.shaping import coast_to_mission_end, never_burn_value_shaping, period_gain_days_per_m_s
 from agents.train import load_config
 from orbit_env.envs.orbit_raising import OrbitRaisingConfig
 from orbit_env.envs.sb3 import make_sb3_vec_env
@@ -14,9 +14,10 @@ from orbit_env.envs.sb3 import make_sb3_vec_env
 def _phi_of(env: gymnasium.Env, steps_left: float) -> float:
     state = env.unwrapped.state
     config = env.unwrapped.config
-    return float(
-        never_burn_days(config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], steps_left)
+    end = coast_to_mission_end(
+        config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], steps_left
     )
+    return float(end.days)
 
 
 def test_shaped_returns_telescope_to_the_true_return_minus_phi_at_the_start():
@@ -73,6 +74,45 @@ def test_phi_is_the_never_return_and_zero_at_the_terminal_states():
     assert _phi_of(env, 0) == 0.0
     env.reset(seed=0, options={"perigee_km": 450.0, "apogee_km": 900.0})
     assert _phi_of(env, horizon) == pytest.approx(total, rel=1e-6)
+
+
+def test_ending_decided_episodes_is_exact():
+    # end_decided=1: an episode ends after the step from a state where the tank is empty or the
+    # satellite outlives the mission. Its shaped return plus Phi(s_0) must be what the same actions,
+    # then coasting, earn in the plain env: the cut-off tail is worth exactly 0 when shaped.
+    n = 32
+    shaped_env = never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=n, seed=11), end_decided=1.0)
+    plain_env = make_sb3_vec_env("OrbitRaising-v0", num_envs=n, seed=11)
+    np.testing.assert_array_equal(shaped_env.reset(), plain_env.reset())
+    phi_start = shaped_env.phi.copy()
+    rng = np.random.default_rng(1)
+    shaped_sum, true_sum = np.zeros(n), np.zeros(n)
+    first = np.ones(n, dtype=bool)  # still in the shaped env's first episode
+    plain_running = np.ones(n, dtype=bool)
+    cut = np.zeros(n, dtype=bool)
+    while plain_running.any():
+        actions = np.where(first & (rng.random(n) < 0.1), rng.integers(1, 4, n), 0)
+        _, shaped, dones, infos = shaped_env.step(actions)
+        _, reward, plain_dones, _ = plain_env.step(actions)
+        shaped_sum += np.where(first, shaped, 0.0)
+        true_sum += np.where(plain_running, reward, 0.0)
+        cut |= first & np.array([info.get("decided_end", False) for info in infos])
+        first &= ~dones
+        plain_running &= ~plain_dones
+    assert cut.sum() >= n // 4 and not cut.all()  # many ended early, some by re-entry
+    np.testing.assert_allclose(shaped_sum + phi_start, true_sum, atol=1e-3)
+
+
+def test_ending_decided_episodes_refuses_where_it_is_not_exact():
+    # The default task: a burn adds at most 0.30 mission day per m/s by the longer period, its cost is 0.4.
+    assert period_gain_days_per_m_s(OrbitRaisingConfig()) == pytest.approx(0.30, abs=0.01)
+    cheap = OrbitRaisingConfig(propellant_cost_per_m_s=0.2)
+    with pytest.raises(ValueError, match="not exact for this config"):
+        never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=2, config=cheap), end_decided=0.5)
+    with pytest.raises(ValueError, match="known, constant density"):
+        never_burn_value_shaping(make_sb3_vec_env("OrbitRaisingUncertain-v0", num_envs=2), end_decided=0.5)
+    with pytest.raises(ValueError, match="probability"):
+        never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=2), end_decided=1.5)
 
 
 def test_config_rejects_an_unknown_shaping(tmp_path):
