@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -72,12 +73,29 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     schedule = config.get("learning_rate_schedule", "constant")
     if schedule not in ("constant", "linear"):
         raise ValueError(f"learning_rate_schedule={schedule!r} is invalid; allowed: constant, linear")
+    decay_start = config.get("learning_rate_decay_start", 0.0)
+    if not (isinstance(decay_start, (int, float)) and 0.0 <= decay_start < 1.0):
+        raise ValueError(f"learning_rate_decay_start={decay_start!r} is invalid; allowed: a fraction in [0, 1)")
     shaping = config.get("shaping", "none")
     if shaping not in SHAPINGS:
         raise ValueError(f"shaping={shaping!r} is invalid; allowed: {', '.join(SHAPINGS)}")
+    end_decided = config.get("end_decided", 0.0)
+    if not (isinstance(end_decided, (int, float)) and 0.0 <= end_decided <= 1.0):
+        raise ValueError(f"end_decided={end_decided!r} is invalid; allowed: a probability in [0, 1]")
+    if end_decided > 0.0 and shaping != "never_burn_value":
+        raise ValueError('end_decided > 0 needs shaping = "never_burn_value" (it ends episodes on its potential)')
     if int(config["total_timesteps"]) <= 0 or int(config["num_envs"]) <= 0:
         raise ValueError("total_timesteps and num_envs must be positive integers")
     return config
+
+
+def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
+    """Learning rate ``rate`` until the fraction ``start`` of the run, then linearly down to 0 at its end.
+
+    SB3 calls the schedule with the progress left, from 1 down to 0.
+    """
+    left_at_start = 1.0 - start
+    return lambda progress_left: rate * min(1.0, progress_left / left_at_start)
 
 
 def shipped_model_path() -> Path:
@@ -125,15 +143,21 @@ def train(
     if config.get("shaping", "none") == "never_burn_value":
         from agents.shaping import never_burn_value_shaping
 
-        venv = never_burn_value_shaping(venv)  # before VecNormalize: it scales the shaped reward
+        # Before VecNormalize: it scales the shaped reward.
+        venv = never_burn_value_shaping(venv, end_decided=float(config.get("end_decided", 0.0)), seed=seed)
     if config.get("normalize", {}).get("reward", False):
         venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=float(config["ppo"]["gamma"]))
     activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
+    policy_kwargs: dict[str, Any] = {"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation}
+    if config["policy"].get("log_features", False):
+        from agents.features import LogFeatures
+
+        policy_kwargs["features_extractor_class"] = LogFeatures
     ppo_kwargs = dict(config["ppo"])
     if config.get("learning_rate_schedule", "constant") == "linear":
-        # SB3 calls the schedule with the progress left, from 1 down to 0.
-        start_rate = float(ppo_kwargs["learning_rate"])
-        ppo_kwargs["learning_rate"] = lambda progress_left: start_rate * progress_left
+        ppo_kwargs["learning_rate"] = linear_decay(
+            float(ppo_kwargs["learning_rate"]), float(config.get("learning_rate_decay_start", 0.0))
+        )
     model = PPO(
         "MlpPolicy",
         venv,
@@ -141,7 +165,7 @@ def train(
         verbose=0,
         device="cpu",
         tensorboard_log=str(out / "tensorboard"),
-        policy_kwargs={"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation},
+        policy_kwargs=policy_kwargs,
         **ppo_kwargs,
     )
     coast_logit = float(config["policy"].get("initial_coast_logit", 0.0))
