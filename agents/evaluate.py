@@ -24,8 +24,11 @@ FloatArray = NDArray[np.float64]
 
 #: Default seed of the evaluation episodes (training uses 0).
 EVAL_SEED = 12345
-#: Default number of episodes.
-EVAL_EPISODES = 200
+#: Default number of episodes: with 1000 the paired difference of two good policies has a
+#: standard error of about 0.1 day (0.3 with 200), below the gaps between them.
+EVAL_EPISODES = 1000
+#: Episodes whose returns differ by less than this [days] count as ties in the paired comparison.
+TIE_DAYS = 0.01
 #: Order of the policies in tables and JSON.
 POLICY_ORDER = ("never", "all_at_once", "apogee_threshold", "greedy", "dp", "ppo")
 
@@ -146,7 +149,14 @@ def paired_difference(results: Mapping[str, Episodes], name: str = "ppo") -> dic
     best = max(baselines, key=lambda b: results[b].returns.mean())
     diff = results[name].returns - results[best].returns
     stderr = float(diff.std(ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else float("nan")
-    return {"policy": name, "baseline": best, "mean": float(diff.mean()), "stderr": stderr}
+    return {
+        "policy": name,
+        "baseline": best,
+        "mean": float(diff.mean()),
+        "stderr": stderr,
+        "better": int(np.sum(diff > TIE_DAYS)),
+        "worse": int(np.sum(diff < -TIE_DAYS)),
+    }
 
 
 def format_table(
@@ -171,7 +181,8 @@ def format_table(
     if paired is not None:
         lines.append(
             f"{paired['policy']} - {paired['baseline']} on the same episodes: {paired['mean']:+.2f} +- "
-            f"{paired['stderr']:.2f} days (mean +- standard error)"
+            f"{paired['stderr']:.2f} days (mean +- standard error); better on {paired['better']}, "
+            f"worse on {paired['worse']} (by more than {TIE_DAYS} day)"
         )
     return "\n".join(lines)
 

@@ -392,10 +392,16 @@ def build_parser() -> argparse.ArgumentParser:
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     tr.set_defaults(func=_cmd_train)
 
+    from agents.evaluate import EVAL_EPISODES, EVAL_SEED
+
     ev = sub.add_parser("evaluate", help="every policy on the same seeded episodes: when does a burn pay off?")
     ev.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
-    ev.add_argument("--episodes", type=_positive_int, default=200, metavar="N", help="episodes (default 200)")
-    ev.add_argument("--seed", type=int, default=12345, metavar="S", help="seed of the episodes (default 12345)")
+    ev.add_argument(
+        "--episodes", type=_positive_int, default=EVAL_EPISODES, metavar="N", help=f"episodes (default {EVAL_EPISODES})"
+    )
+    ev.add_argument(
+        "--seed", type=int, default=EVAL_SEED, metavar="S", help=f"seed of the episodes (default {EVAL_SEED})"
+    )
     ev.add_argument("--model", metavar="ZIP", help="PPO model (default: the shipped one for the environment)")
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
     ev.add_argument("--json", action="store_true", help="print one JSON object")

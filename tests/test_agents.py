@@ -53,6 +53,7 @@ def test_paired_difference_is_against_the_best_hand_coded_policy(baseline_result
     assert paired["baseline"] == "greedy" and paired["policy"] == "ppo"
     assert paired["mean"] == pytest.approx(wobble.mean())
     assert paired["stderr"] == pytest.approx(wobble.std(ddof=1) / np.sqrt(wobble.size))
+    assert (paired["better"], paired["worse"]) == ((wobble > 0).sum(), (wobble < 0).sum())
     assert paired_difference(baseline_results) is None  # no ppo
 
 
