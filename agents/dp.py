@@ -1,59 +1,89 @@
-"""The exact optimum of the known-density task by backward induction on a grid.
+"""The optimum of the known-density task by backward induction on a grid.
 
 SI units inside (m, kg, s, m/s); values and rewards in days, as the env's reward.
 
 State. The env's state is a point on the universal curves (label mu, tau), the
 mass and the steps left. The grid uses three coordinates of it:
 
-* mu, the curve's label, uniform on [``MU_LOW``, the domain's largest label].
-  Below ``MU_LOW`` (e < 1e-7 at re-entry) the orbits are circular to within
-  metres; there the curves are translates of each other (see
-  :mod:`orbit_env.curves`) and carry the same lifetime, so the value is clamped.
+* mu, the curve's label. A perigee burn moves an orbit across the curves by an
+  amount that shrinks by two orders of magnitude from nearly circular to
+  elongated orbits: at half the horizon's life, 10 m/s moves mu by 0.61 at
+  mu = -13 (431 x 464 km), by 0.014 at -10 (285 x 1032 km) and by 0.0046 at
+  -9.2 (234 x 2332 km). The value changes on that scale, as it is a maximum
+  over plans of discrete burns, and a grid coarser than it is optimistic: a
+  burn's landing point between labels is valued as if the satellite could
+  follow both neighbours' plans, and the maximum over actions picks those
+  errors up stage after stage. So the labels are spaced in proportion to the
+  label change of the smallest burn (at the wet mass and ``LABEL_REFERENCE_LIFE``
+  of the horizon), at most ``LABEL_MAX_SPACING`` apart, from ``MU_LOW`` up to
+  where that orbit's apogee reaches ``LABEL_FINE_APOGEE`` of the 4000 km cap;
+  above, where only orbits with very low perigees lie and no burn pays (in 1000
+  evaluation episodes the DP policy, the greedy look-ahead and PPO burn below
+  mu = -9.07), the spacing grows
+  geometrically up to the most elongated reachable orbit. Below ``MU_LOW``
+  (e < 1e-7 at re-entry) the orbits are circular to within metres and carry the
+  same lifetime (see :mod:`orbit_env.curves`): the value is clamped.
 * n = nu / (K g c s), the lifetime left in steps at the current mass: a coast of
   one step moves it from n to n - 1 exactly, so with ``life_per_step`` levels per
-  unit of n up to the horizon (and a geometric tail above it, where every orbit
-  outlives the mission) coasting needs no interpolation and the value's kink at
-  n = steps left sits on the grid.
+  unit of n up to the horizon + 1 (and a geometric tail above, where every orbit
+  outlives the mission) coasting needs no interpolation.
 * the delta-v left, anchored at the full tank and spaced by the greatest common
   divisor of the burn sizes over ``dv_per_quantum``, plus 0: every burn from a
   grid level lands on a grid level unless the 4000 km apogee cap cuts it.
 
+A satellite that outlives the k steps left by coasting (n >= k) coasts: a burn
+would buy days only through a longer period, at most c0 day per m/s and step
+left (c0 = K max dP/d(dv) over the curves' domain / day = 8.2e-4), which is
+below the propellant's cost for k < cost / c0 (all 365 stages of the default
+config: 0.30 < 0.4 day per m/s at k = 365). Its value is the exact sum of the
+coasts' days: a difference of cumulative sums on the life levels, the drop of
+the curves' W in the tail. So only the states with n <= k decide: they are the
+only ones stored (half of the grid over the stages), the backward induction
+touches only them, and states that outlive the mission get exact values instead
+of interpolated coasts through the tail. The stages beyond cost / c0 (cheap
+propellant, long missions) decide on every state.
+
 Only a burn's landing point in (mu, n) is interpolated (multilinearly). The
 transitions are the env's own functions on whole arrays of grid states:
 ``perigee_burn`` at the heights of ``curves.at``, ``curves.locate`` of the new
-orbit (with the mean period from ``at``, as the env's ``_set_point``), and
-``coast``; reward = days - cost * dv, re-entered states are worth 0.
-For every action the successor and reward are computed once, stored as a
-scipy.sparse interpolation matrix P_a and a vector r_a, and then
-V_k = max_a (r_a + P_a V_{k-1}) for k = 1..horizon, V_0 = 0. The policy acts by
-the same one-step look-ahead from the state recovered from the observation:
-argmax_a r_a(s) + V_{k-1}(successor) interpolated.
+orbit, and ``coast``; reward = days - cost * dv, re-entered states are worth 0.
+For every action the successor and reward are computed once (in chunks, so the
+curves' tables stay in cache), stored as a scipy.sparse interpolation matrix P_a
+and a vector r_a, and then V_k = max_a (r_a + P_a V_{k-1}) on the deciding
+states of stage k, for k = 1..horizon, V_0 = 0, in float32; the values are
+stored as uint16 in steps of 0.01 day. The policy acts by the same one-step
+look-ahead from the state recovered from the observation: argmax_a r_a(s) +
+V_{k-1}(successor), with V_{k-1} interpolated, or the exact sum of the coasts'
+days where the successor outlives the mission.
 
-Grid refinement (default config, density scale 1, mean optimum over 200 seeded
-start states of ``OrbitRaising-v0`` (seeds 0..199), one core of a 2-core machine
-shared with a training run):
+Grid refinement on the 200 evaluation episodes of ``orbit-env evaluate``
+(seed 12345; default config, density scale 1): "value" is the mean of
+:meth:`DPSolution.value` at the start states, "realized" the mean return of
+:class:`DPPolicy` in the env, |d| = |value - realized| per episode, "greedy
+ahead" the worst episode's lead of the greedy look-ahead over the DP policy.
+Solve times on one core of a 2-core machine with a PPO training on the other;
+"memory" is the solving process' peak.
 
-=========  ==========  =========  ==========  ===========  ===========
-labels     states      solve [s]  optimum     DP in env    change of
-                                  (value)     (200 eps)    optimum
-=========  ==========  =========  ==========  ===========  ===========
-24         300 288     12.7*      301.42      297.02       --
-32         400 384     13.7*      301.00      297.45       -0.14%
-48         600 576     10.8       300.76      299.30       -0.08%
-64         800 768     14.9       300.66      299.86       -0.03%
-=========  ==========  =========  ==========  ===========  ===========
+=========  =========  =========  ======  =======  ========  ========  =========  ========
+grid       states     solve [s]  memory  value    realized  mean |d|  worst |d|  greedy
+                                 [GB]                                            ahead
+=========  =========  =========  ======  =======  ========  ========  =========  ========
+32, 1, 1     400 384        3.2    0.36  265.287   264.020      1.29       25.6      22.2
+64, 1, 1     800 768        6.3    0.61  265.258   264.719      0.57       13.0      11.5
+96, 1, 1   1 201 152        9.1    0.84  265.233   264.998      0.26        5.5       3.6
+128, 1, 1  1 601 536       12.6    1.08  265.218   265.077      0.16        2.9       2.6
+160, 1, 1  2 001 920       16.3    1.31  265.210   265.112      0.13        2.7       1.2
+192, 1, 1  2 402 304       19.6    1.50  265.206   265.133      0.10        1.9       1.1
+256, 1, 1  3 203 072       26.4    1.96  265.196   265.154      0.07        1.8       1.1
+192, 1, 2  4 654 464       38.7    2.76  265.206   265.133      0.10        1.9       1.1
+192, 2, 1  4 651 008       41.9    2.83  265.203   265.141      0.09        1.5       0.8
+=========  =========  =========  ======  =======  ========  ========  =========  ========
 
-(returns in days; life and delta-v levels 1 per step and per 10 m/s: refining
-them, (48, 2, 1) and (48, 1, 2), changed nothing measurable on the test task, as
-their transitions are exact; * measured with a second solve running.) The
-optimum moves by less than 0.5% from 24 labels on; the policy acting on the
-interpolated values needs more: with 24 labels it earns 1.5% less than its
-value, with 48 labels 0.5%, with 64 labels 0.3%. On the same 200 episodes never
-burning returns 261.6 days and the whole tank at once 244.0: the optimum beats
-them by 15% and 23% (value at 48 labels), its policy in the env by 14% and 23%.
-The default grid is (64, 1, 1): about 20 s and 0.6 GB of values stored as uint16
-in steps of 0.01 day. On the evaluation episodes of `orbit-env evaluate` (seed 12345)
-the DP policy earns 262.8, 263.6 and 263.9 days at 48, 64 and 96 labels.
+The value moves by less than 0.04% from 32 labels on, the realized return
+converges to it (0.03% below at 192 labels). Halving the delta-v spacing
+changes nothing (the burns land on its levels); halving the life spacing halves
+the worst episodes' errors, at twice the cost. The default grid is (192, 1, 1).
+See docs/dp.md for the baselines and the previous version's numbers.
 """
 
 from __future__ import annotations
@@ -63,14 +93,15 @@ import sys
 import time
 from dataclasses import dataclass
 from functools import lru_cache, reduce
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
+from scipy.optimize import brentq
 
 from agents.policies import observation_batch
-from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
@@ -88,35 +119,56 @@ from orbit_env.envs.orbit_raising import (
     delta_v_left_m_s,
     perigee_burn,
 )
+from orbit_env.orbit import apogee_after_perigee_burn_m, elements_from_heights, period_s
 
 FloatArray = NDArray[np.float64]
 
 #: Default grid: (labels, life levels per step, delta-v levels per burn quantum).
-DEFAULT_GRID = (64, 1, 1)
+DEFAULT_GRID = (192, 1, 1)
 #: Resolution of the stored values [days].
 VALUE_QUANTUM_DAYS = 0.01
 #: Lowest label on the grid; below it orbits are circular to within metres.
 MU_LOW = -14.0
-#: Labels where 98% of the start orbits of the default config and of their burns
-#: lie (measured on 50000 starts); the grid puts 3/4 of its labels there.
-CORE_LABELS = (-12.5, -7.0)
+#: Widest spacing of the labels (nearly circular orbits, where a burn moves mu most).
+LABEL_MAX_SPACING = 0.3
+#: Life (as a fraction of the horizon, at the wet mass) at which the label change of
+#: the smallest burn sets the labels' spacing.
+LABEL_REFERENCE_LIFE = 0.5
+#: Fraction of the apogee cap above which the labels' spacing grows geometrically.
+LABEL_FINE_APOGEE = 0.7
 #: Labels above the most elongated reachable orbit's that the grid still covers.
 LABEL_MARGIN = 0.2
 #: Levels of the geometric tail of the life axis, above the horizon.
 LIFE_TAIL_LEVELS = 24
+#: States per chunk of the transitions' computation (the curves' tables stay in cache).
+CHUNK_STATES = 16384
 
 
 @dataclass(frozen=True)
 class _Axes:
-    """The grid's axes and the satellite they were built for."""
+    """The grid's axes. States are stored life-major: (life level, label, delta-v level).
+
+    So the decision states of a stage, n <= k, are a prefix of the state vector.
+    """
 
     label: FloatArray
     life: FloatArray
     dv_m_s: FloatArray
+    unit_levels: int  # life levels spaced 1 / life_per_step, from 0 to the horizon + 1
+    life_per_step: int
 
     @property
     def shape(self) -> tuple[int, int, int]:
-        return (self.label.size, self.life.size, self.dv_m_s.size)
+        return (self.life.size, self.label.size, self.dv_m_s.size)
+
+    @property
+    def plane(self) -> int:
+        """States per life level."""
+        return self.label.size * self.dv_m_s.size
+
+    @property
+    def size(self) -> int:
+        return self.life.size * self.plane
 
 
 def _axis_weights(axis: FloatArray, x: FloatArray) -> tuple[NDArray[np.intp], FloatArray]:
@@ -133,21 +185,30 @@ def _axis_weights(axis: FloatArray, x: FloatArray) -> tuple[NDArray[np.intp], Fl
 
 def _interpolation(axes: _Axes, label: FloatArray, life: FloatArray, dv_m_s: FloatArray) -> tuple[Any, Any]:
     """Flat grid indices (m, 8) and trilinear weights (m, 8) of query states."""
-    n1, n2, n3 = axes.shape
-    (i, ti), (j, tj), (k, tk) = (
-        _axis_weights(axes.label, label),
+    n_life, n_label, n_dv = axes.shape
+    (j, tj), (i, ti), (k, tk) = (
         _axis_weights(axes.life, life),
+        _axis_weights(axes.label, label),
         _axis_weights(axes.dv_m_s, dv_m_s),
     )
     index, weight = [], []
-    for di, wi in ((0, 1.0 - ti), (1, ti)):
-        for dj, wj in ((0, 1.0 - tj), (1, tj)):
+    for dj, wj in ((0, 1.0 - tj), (1, tj)):
+        for di, wi in ((0, 1.0 - ti), (1, ti)):
             for dk, wk in ((0, 1.0 - tk), (1, tk)):
-                index.append(
-                    ((np.minimum(i + di, n1 - 1) * n2 + np.minimum(j + dj, n2 - 1)) * n3) + (np.minimum(k + dk, n3 - 1))
-                )
-                weight.append(wi * wj * wk)
+                flat = (np.minimum(j + dj, n_life - 1) * n_label + np.minimum(i + di, n_label - 1)) * n_dv
+                index.append(flat + np.minimum(k + dk, n_dv - 1))
+                weight.append(wj * wi * wk)
     return np.stack(index, axis=-1), np.stack(weight, axis=-1)
+
+
+class _Step(NamedTuple):
+    """One env step from arrays of states."""
+
+    point: CurvePoint  # after the burn and the coast
+    mass_kg: FloatArray
+    life: FloatArray  # steps of life left at the new mass (0 once re-entered)
+    dv_left_m_s: FloatArray
+    reward: FloatArray
 
 
 class _Model:
@@ -168,34 +229,166 @@ class _Model:
         """Mass from the delta-v left, by the rocket equation."""
         return self.config.dry_mass_kg * np.exp(dv_left_m_s / self.config.exhaust_velocity_m_s)
 
-    def point(self, label: FloatArray, tau: FloatArray) -> CurvePoint:
-        """A point with its mean period from ``at``, as the env's ``_set_point``."""
-        return CurvePoint(label, tau, self.curves.at(label, tau)[2])
+    def point(self, label: FloatArray, tau: FloatArray) -> tuple[CurvePoint, FloatArray, FloatArray]:
+        """The point at (label, tau), with its mean period from ``at`` as the env's, and its heights [m]."""
+        perigee_m, apogee_m, q = self.curves.at(label, tau)
+        return CurvePoint(label, tau, q), perigee_m, apogee_m
 
     def step(
-        self, point: CurvePoint, mass_kg: FloatArray, requested_dv_m_s: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """The env's step from ``point``: successor (label, life in steps, delta-v left) and reward."""
+        self, point: CurvePoint, perigee_m: FloatArray, apogee_m: FloatArray, mass_kg: FloatArray, requested_dv: float
+    ) -> _Step:
+        """The env's step from ``point`` (with its heights): burn (maybe), then coast."""
         config = self.config
-        perigee_m, apogee_m, _ = self.curves.at(point.label, point.tau)
         dv, apogee_after, mass_after = perigee_burn(
-            perigee_m, apogee_m, mass_kg, config.dry_mass_kg, config.exhaust_velocity_m_s, requested_dv_m_s
+            perigee_m, apogee_m, mass_kg, config.dry_mass_kg, config.exhaust_velocity_m_s, requested_dv
         )
         burned = dv > 0.0
         if np.any(burned):
+            # As the env's _set_point: the new orbit located, its mean period from table B.
             moved = self.curves.locate(perigee_m, apogee_after)
-            label = np.where(burned, moved.label, point.label)
-            tau = np.where(burned, moved.tau, point.tau)
-            point = self.point(label, tau)
+            point = CurvePoint(
+                np.where(burned, moved.label, point.label),
+                np.where(burned, moved.tau, point.tau),
+                np.where(burned, moved.mean_period_s, point.mean_period_s),
+            )
             mass_after = np.where(burned, mass_after, mass_kg)
         else:
             mass_after = np.asarray(mass_kg, dtype=np.float64) + np.zeros_like(point.tau)
             dv = np.zeros_like(point.tau)
-        nu_per_rev = self.step_nu(mass_after) / config.revolutions_per_step
-        after, _, _, days, _ = coast(self.curves, point, config.revolutions_per_step, nu_per_rev)
+        after, days = self.coast(point, mass_after, 1.0)
         life = np.where(after.tau > 0.0, after.nu / self.step_nu(mass_after), 0.0)
         dv_left = np.maximum(delta_v_left_m_s(mass_after, config.dry_mass_kg, config.exhaust_velocity_m_s), 0.0)
-        return after.label, life, dv_left, days - config.propellant_cost_per_m_s * dv
+        return _Step(after, mass_after, life, dv_left, days - config.propellant_cost_per_m_s * dv)
+
+    def coast(self, point: CurvePoint, mass_kg: FloatArray, steps: Any) -> tuple[CurvePoint, FloatArray]:
+        """The point after coasting ``steps`` steps and the days lived meanwhile (the env's ``coast``)."""
+        nu_per_rev = self.step_nu(mass_kg) / self.config.revolutions_per_step
+        after, _, _, days, _ = coast(
+            self.curves, point, np.multiply(steps, self.config.revolutions_per_step), nu_per_rev
+        )
+        return after, days
+
+    def coast_days(self, point: CurvePoint, mass_kg: FloatArray, steps: Any) -> FloatArray:
+        """The days of ``steps`` coasts in one: the drop of W over g c s (the sum of the env's coasts' days).
+
+        ``curves.advance`` alone (the mean period, not the heights): a quarter of
+        the work of :meth:`coast`, for the many states that outlive the mission.
+        """
+        nu_per_rev = self.step_nu(mass_kg) / self.config.revolutions_per_step
+        after = self.curves.advance(point, np.multiply(steps, self.config.revolutions_per_step) * nu_per_rev)
+        return (point.weighted_s - after.weighted_s) / (nu_per_rev * SECONDS_PER_DAY)
+
+
+def _coast_certain_stages(model: _Model) -> int:
+    """The stages k (steps left) up to which a satellite that outlives them coasts in the optimum.
+
+    With n >= k the satellite lives through the mission coasting; a burn of dv
+    then changes the return by the days of longer periods, at most c0 * k * dv,
+    minus cost * dv. c0 = K max dP/d(dv) / day, the largest rate over the curves'
+    domain (P grows convexly with the perigee speed, so a finite burn gains
+    less per m/s than the rate at its end, which lies in the domain; assumed:
+    the difference of the periods does not grow as both orbits decay, checked by
+    solving with every state deciding in tests/test_dp.py). Returns the largest
+    k with c0 * k < cost, at most the horizon.
+    """
+    config = model.config
+    if config.delta_v_capacity_m_s <= 0.0 or max(config.burn_sizes_m_s) <= 0.0:
+        return config.horizon_steps
+    perigee_m = np.linspace(REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M, 101)
+    step_m_s = 1e-3
+    p, e = elements_from_heights(perigee_m, CURVES_MAX_APOGEE_M)
+    p2, e2 = elements_from_heights(perigee_m, apogee_after_perigee_burn_m(perigee_m, CURVES_MAX_APOGEE_M, step_m_s))
+    rate_s_per_m_s = float(np.max(period_s(p2, e2) - period_s(p, e)) / step_m_s)
+    c0 = config.revolutions_per_step * rate_s_per_m_s / SECONDS_PER_DAY
+    stages = math.ceil(config.propellant_cost_per_m_s / c0) - 1
+    return int(min(max(stages, 0), config.horizon_steps))
+
+
+def _gcd(values: tuple[float, ...]) -> float:
+    """Greatest common divisor of the positive burn sizes (to 1e-6 m/s); 0 if none."""
+    micro = [round(v * 1e6) for v in values if v > 0.0]
+    return reduce(math.gcd, micro, 0) / 1e6
+
+
+def _top_label(model: _Model) -> float:
+    """Label of the most elongated orbit reachable, plus ``LABEL_MARGIN``.
+
+    The most elongated start (lowest perigee, highest apogee), decayed to any point
+    of its curve and raised with the whole tank.
+    """
+    config = model.config
+    curves = model.curves
+    start = curves.locate(np.array([config.start_perigee_km[0] * 1e3]), np.array([config.start_apogee_max_km * 1e3]))
+    along = np.linspace(0.0, 1.0, 201) * start.tau[0]
+    perigee_m, apogee_m, _ = curves.at(np.full(along.size, start.label[0]), along)
+    _, raised_m, _ = perigee_burn(
+        perigee_m, apogee_m, config.wet_mass_kg, config.dry_mass_kg, config.exhaust_velocity_m_s, np.inf
+    )
+    return max(float(curves.locate(perigee_m, raised_m).label.max()) + LABEL_MARGIN, MU_LOW + 1.0)
+
+
+def _labels(model: _Model, n_label: int) -> FloatArray:
+    """The label axis: spacing in proportion to the label change of the smallest burn (see the module)."""
+    config = model.config
+    top = _top_label(model)
+    burns = [b for b in config.burn_sizes_m_s if b > 0.0]
+    if n_label < 6 or not burns or config.delta_v_capacity_m_s <= 0.0:
+        return np.linspace(MU_LOW, top, n_label)
+    mu = np.arange(MU_LOW, top, 0.002)
+    mass = np.full(mu.size, config.wet_mass_kg)
+    life = LABEL_REFERENCE_LIFE * config.horizon_steps
+    point, perigee_m, apogee_m = model.point(mu, np.log1p(life * model.step_nu(mass) / NU_REF))
+    moved = model.step(point, perigee_m, apogee_m, mass, min(burns)).point.label - mu
+    fine = (apogee_m <= LABEL_FINE_APOGEE * CURVES_MAX_APOGEE_M) & (moved > 0.0)
+    end = int(np.argmin(fine)) if not fine.all() else mu.size
+    if end < 2:
+        return np.linspace(MU_LOW, top, n_label)
+    density = np.maximum(1.0 / np.maximum(moved[:end], 1e-9), 1.0 / LABEL_MAX_SPACING)
+    u = np.concatenate([[0.0], np.cumsum(0.5 * (density[1:] + density[:-1]) * np.diff(mu[:end]))])
+    n_above = max(2, n_label // 12)
+    fine_labels = np.interp(np.linspace(0.0, u[-1], n_label - n_above), u, mu[:end])
+    # Above: spacings h q, h q^2, ... from the last fine spacing h, summing to the rest of the range.
+    h, rest = fine_labels[-1] - fine_labels[-2], top - fine_labels[-1]
+    powers = np.arange(1, n_above + 1)
+    if h * n_above >= rest:
+        ratio = 1.0
+    else:
+        ratio = brentq(lambda q: h * np.sum(q**powers) - rest, 1.0, 1e3)
+    above = fine_labels[-1] + np.cumsum(h * ratio**powers)
+    above[-1] = top
+    return np.concatenate([fine_labels, above])
+
+
+def _axes(model: _Model, grid: tuple[int, int, int]) -> _Axes:
+    config = model.config
+    n_label, life_per_step, dv_per_quantum = grid
+    curves = model.curves
+    label = _labels(model, n_label)
+    horizon = config.horizon_steps
+    # The longest life in the domain, in steps of the heaviest satellite.
+    highest = curves.locate(np.array([CURVES_MAX_PERIGEE_M]), np.array([CURVES_MAX_APOGEE_M]))
+    life_max = max(float(highest.nu[0] / model.step_nu(config.wet_mass_kg)), 2.0 * (horizon + 1))
+    unit = np.arange(0, (horizon + 1) * life_per_step + 1) / life_per_step
+    tail = np.geomspace(horizon + 1, life_max, LIFE_TAIL_LEVELS + 1)[1:]
+    capacity = config.delta_v_capacity_m_s
+    quantum = _gcd(config.burn_sizes_m_s)
+    if capacity > 0.0 and quantum > 0.0:
+        spacing = quantum / dv_per_quantum
+        levels = capacity - spacing * np.arange(int(capacity / spacing) + 1)
+        dv_m_s = np.unique(np.concatenate([[0.0], levels[levels > 1e-9]]))
+    else:
+        dv_m_s = np.array([0.0, capacity]) if capacity > 0.0 else np.array([0.0])
+    return _Axes(label, np.concatenate([unit, tail]), dv_m_s, unit.size, life_per_step)
+
+
+def _grid_states(model: _Model, axes: _Axes, rows: NDArray[np.intp]) -> tuple[CurvePoint, FloatArray, FloatArray, Any]:
+    """Point, heights and mass of flat grid states."""
+    j, rest = np.divmod(rows, axes.plane)
+    i, k = np.divmod(rest, axes.dv_m_s.size)
+    mass = model.mass_kg(axes.dv_m_s[k])
+    tau = np.log1p(axes.life[j] * model.step_nu(mass) / NU_REF)
+    point, perigee_m, apogee_m = model.point(axes.label[i], tau)
+    return point, perigee_m, apogee_m, mass
 
 
 @dataclass
@@ -215,33 +408,81 @@ class DPSolution:
     solve_s: float
     _model: _Model
     _axes: _Axes
-    _values: NDArray[np.uint16]  # (horizon + 1, states), in units of VALUE_QUANTUM_DAYS
+    _values: NDArray[np.uint16]  # the decision states of every stage, in units of VALUE_QUANTUM_DAYS
+    _offsets: NDArray[np.int64]  # where stage k's values start in _values
+    _rows: NDArray[np.int64]  # decision states of stage k (a prefix of the state vector)
+    _cumulative: FloatArray  # sums of the coasts' days along the life levels [days]
+    _coast_certain: int  # stages up to which the satellites that outlive them coast
+    _tail: tuple[CurvePoint, FloatArray]  # the states of the life axis' tail and their masses
 
     @property
     def num_states(self) -> int:
         """Grid states per stage."""
-        return int(self._values.shape[1])
+        return self._axes.size
+
+    @property
+    def stored_values(self) -> int:
+        """Values stored over all stages (the decision states)."""
+        return int(self._values.size)
+
+    def _coast_days(self, stage: int, rows: NDArray[np.intp]) -> FloatArray:
+        """The days of ``stage`` coasts from grid states that outlive them [days]."""
+        axes = self._axes
+        unit_rows = axes.unit_levels * axes.plane
+        out = np.empty(rows.shape)
+        unit = rows < unit_rows
+        shift = stage * axes.life_per_step * axes.plane
+        out[unit] = self._cumulative[rows[unit]] - self._cumulative[rows[unit] - shift]
+        tail = np.flatnonzero(~unit)
+        point, mass = self._tail
+        for start in range(0, tail.size, CHUNK_STATES):
+            chunk = tail[start : start + CHUNK_STATES]
+            at = rows[chunk] - unit_rows
+            part = CurvePoint(point.label[at], point.tau[at], point.mean_period_s[at])
+            out[chunk] = self._model.coast_days(part, mass[at], stage)
+        return out
+
+    def stage_values(self, stage: int, rows: Any = None) -> FloatArray:
+        """V_stage at flat grid states (default: all of them) [days]."""
+        rows = np.arange(self.num_states) if rows is None else np.asarray(rows, dtype=np.intp)
+        if stage == 0:
+            return np.zeros(rows.shape)
+        out = np.empty(rows.shape)
+        stored = rows < self._rows[stage]
+        out[stored] = self._values[self._offsets[stage] + rows[stored]] * VALUE_QUANTUM_DAYS
+        if not stored.all():
+            out[~stored] = self._coast_days(stage, rows[~stored])
+        return out
 
     def _state(
         self, perigee_m: FloatArray, apogee_m: FloatArray, dv_left_m_s: FloatArray
-    ) -> tuple[CurvePoint, FloatArray]:
-        """The env's point and mass for observed heights and delta-v left."""
+    ) -> tuple[CurvePoint, FloatArray, FloatArray, FloatArray]:
+        """The env's point, heights and mass for observed heights and delta-v left."""
         model = self._model
         located = model.curves.locate(perigee_m, apogee_m)
-        return model.point(located.label, located.tau), model.mass_kg(dv_left_m_s)
+        point, perigee, apogee = model.point(located.label, located.tau)
+        return point, perigee, apogee, model.mass_kg(dv_left_m_s)
 
     def q_values(
         self, perigee_m: FloatArray, apogee_m: FloatArray, dv_left_m_s: FloatArray, steps_left: NDArray[np.intp]
     ) -> FloatArray:
         """r_a + V_{k-1}(successor_a) for each state (rows) and action (columns) [days]; 0 at k = 0."""
-        point, mass = self._state(perigee_m, apogee_m, dv_left_m_s)
+        point, perigee, apogee, mass = self._state(perigee_m, apogee_m, dv_left_m_s)
         stage = np.clip(steps_left - 1, 0, self.config.horizon_steps - 1)
         q = np.empty((np.size(point.tau), len(self.config.burn_sizes_m_s)))
         for a, burn in enumerate(self.config.burn_sizes_m_s):
-            label, life, dv_left, reward = self._model.step(point, mass, burn)
-            index, weight = _interpolation(self._axes, label, life, dv_left)
-            future = (self._values[stage[:, None], index] * weight).sum(axis=1) * VALUE_QUANTUM_DAYS
-            q[:, a] = reward + future
+            step = self._model.step(point, perigee, apogee, mass, burn)
+            future = np.zeros(q.shape[0])
+            # A successor that outlives the mission coasts: its days are summed exactly.
+            exact = (stage <= self._coast_certain) & (step.life >= stage)
+            if exact.any():
+                after = CurvePoint(step.point.label[exact], step.point.tau[exact], step.point.mean_period_s[exact])
+                future[exact] = self._model.coast_days(after, step.mass_kg[exact], stage[exact])
+            index, weight = _interpolation(self._axes, step.point.label, step.life, step.dv_left_m_s)
+            for s in np.unique(stage[~exact]):
+                mine = ~exact & (stage == s)
+                future[mine] = (self.stage_values(int(s), index[mine]) * weight[mine]).sum(axis=1)
+            q[:, a] = step.reward + future
         # A re-entered satellite or an ended mission earns nothing more.
         q[(steps_left <= 0) | (point.tau <= 0.0)] = 0.0
         return q
@@ -271,52 +512,6 @@ class DPSolution:
         shape = hp.shape
         q = self.q_values(hp.ravel(), ha.ravel(), dv.ravel(), k.ravel().astype(np.intp))
         return q.max(axis=1).reshape(shape)
-
-
-def _gcd(values: tuple[float, ...]) -> float:
-    """Greatest common divisor of the positive burn sizes (to 1e-6 m/s); 0 if none."""
-    micro = [round(v * 1e6) for v in values if v > 0.0]
-    return reduce(math.gcd, micro, 0) / 1e6
-
-
-def _axes(model: _Model, grid: tuple[int, int, int]) -> _Axes:
-    config = model.config
-    n_label, life_per_step, dv_per_quantum = grid
-    curves = model.curves
-    # The most elongated orbit reachable: the most elongated start (lowest perigee,
-    # highest apogee), decayed to any point of its curve and raised with the whole tank.
-    start = curves.locate(np.array([config.start_perigee_km[0] * 1e3]), np.array([config.start_apogee_max_km * 1e3]))
-    along = np.linspace(0.0, 1.0, 201) * start.tau[0]
-    perigee_m, apogee_m, _ = curves.at(np.full(along.size, start.label[0]), along)
-    _, raised_m, _ = perigee_burn(
-        perigee_m, apogee_m, config.wet_mass_kg, config.dry_mass_kg, config.exhaust_velocity_m_s, np.inf
-    )
-    top = float(curves.locate(perigee_m, raised_m).label.max()) + LABEL_MARGIN
-    top = max(top, CORE_LABELS[1] + 0.5)
-    # Most of the levels where the start orbits and their burns lie, the rest outside.
-    outer = max(1, n_label // 8) if n_label >= 6 else 0
-    if outer:
-        core = np.linspace(*CORE_LABELS, n_label - 2 * outer)
-        below = np.linspace(MU_LOW, CORE_LABELS[0], outer + 1)[:-1]
-        above = np.linspace(CORE_LABELS[1], top, outer + 1)[1:]
-        label = np.concatenate([below, core, above])
-    else:
-        label = np.linspace(MU_LOW, top, n_label)
-    horizon = config.horizon_steps
-    # The longest life in the domain, in steps of the heaviest satellite.
-    highest = curves.locate(np.array([CURVES_MAX_PERIGEE_M]), np.array([CURVES_MAX_APOGEE_M]))
-    life_max = max(float(highest.nu[0] / model.step_nu(config.wet_mass_kg)), 2.0 * (horizon + 1))
-    unit = np.arange(0, (horizon + 1) * life_per_step + 1) / life_per_step
-    tail = np.geomspace(horizon + 1, life_max, LIFE_TAIL_LEVELS + 1)[1:]
-    capacity = config.delta_v_capacity_m_s
-    quantum = _gcd(config.burn_sizes_m_s)
-    if capacity > 0.0 and quantum > 0.0:
-        spacing = quantum / dv_per_quantum
-        levels = capacity - spacing * np.arange(int(capacity / spacing) + 1)
-        dv_m_s = np.unique(np.concatenate([[0.0], levels[levels > 1e-9]]))
-    else:
-        dv_m_s = np.array([0.0, capacity]) if capacity > 0.0 else np.array([0.0])
-    return _Axes(label, np.concatenate([unit, tail]), dv_m_s)
 
 
 def _check_grid(grid: Any) -> tuple[int, int, int]:
@@ -363,40 +558,145 @@ def solve(
     return _solve(config, grid, float(density_scale), bool(progress))
 
 
+def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArray[np.float32], list[Any], Any]:
+    """Rewards (actions, states), the actions' interpolation matrices and the tail's coast matrix.
+
+    The actions are the coast first (if the config has one), then the burns in
+    the config's order; the burns' matrices cover the states that ever decide
+    (the first ``decision_rows``). Coasts from the life levels up to the
+    horizon + 1 land on the level below (checked) and need no matrix; coasts
+    from the tail do where its states decide (None otherwise).
+    """
+    config = model.config
+    n, unit_rows = axes.size, axes.unit_levels * axes.plane
+    has_coast = 0.0 in config.burn_sizes_m_s
+    burns = [b for b in config.burn_sizes_m_s if b != 0.0] if has_coast else list(config.burn_sizes_m_s)
+    actions = [0.0] * has_coast + burns
+    rewards = np.zeros((len(actions), n), np.float32)
+    parts: list[list[tuple[Any, Any, Any]]] = [[] for _ in actions]
+    down = axes.life_per_step * axes.plane
+    for start in range(0, n, CHUNK_STATES):
+        rows = np.arange(start, min(start + CHUNK_STATES, n))
+        point, perigee_m, apogee_m, mass = _grid_states(model, axes, rows)
+        alive = point.tau > 0.0
+        for a, burn in enumerate(actions):
+            coasting = has_coast and a == 0
+            if not coasting and start >= decision_rows:
+                parts[a].append((np.zeros(rows.size, np.int64), np.zeros(0, np.int32), np.zeros(0, np.float32)))
+                continue
+            step = model.step(point, perigee_m, apogee_m, mass, burn)
+            index, weight = _interpolation(axes, step.point.label, step.life, step.dv_left_m_s)
+            keep = (weight > 0.0) & alive[:, None]
+            rewards[a, rows] = np.where(alive, step.reward, 0.0)
+            if coasting:
+                unit = alive & (rows < unit_rows) & (rows >= down)
+                assert np.all(keep[unit].sum(axis=1) == 1), "a coast between life levels must land on a level"
+                assert np.all(index[unit][keep[unit]] == rows[unit] - down), "a coast moves one step down"
+                keep &= (rows >= unit_rows)[:, None]
+            keep &= (rows < decision_rows)[:, None]
+            parts[a].append((keep.sum(axis=1), index[keep].astype(np.int32), weight[keep].astype(np.float32)))
+    matrices = []
+    for part in parts:
+        indptr = np.concatenate([[0], np.cumsum(np.concatenate([p[0] for p in part]))])
+        indices = np.concatenate([p[1] for p in part])
+        data = np.concatenate([p[2] for p in part])
+        # One index type for both (int32 while it fits), so that the stages' row prefixes copy nothing.
+        index_dtype = np.int32 if indptr[-1] < np.iinfo(np.int32).max and n < np.iinfo(np.int32).max else np.int64
+        matrix = sp.csr_matrix((data, indices.astype(index_dtype), indptr.astype(index_dtype)), shape=(n, n))
+        assert matrix.indptr.dtype == matrix.indices.dtype == index_dtype
+        matrices.append(matrix)
+    tail_coast = None
+    if has_coast:
+        coast_matrix = matrices.pop(0)
+        tail_coast = coast_matrix[unit_rows:] if decision_rows > unit_rows else None
+    return rewards, matrices, tail_coast
+
+
+def _prefix(matrix: Any, rows: int) -> Any:
+    """The first ``rows`` rows of a CSR matrix, sharing its arrays."""
+    return sp.csr_matrix((matrix.data, matrix.indices, matrix.indptr[: rows + 1]), shape=(rows, matrix.shape[1]))
+
+
 @lru_cache(maxsize=4)
 def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, progress: bool) -> DPSolution:
     start = time.perf_counter()
     model = _Model(config, density_scale)
     axes = _axes(model, grid)
-    label, life, dv_left = (a.ravel() for a in np.meshgrid(axes.label, axes.life, axes.dv_m_s, indexing="ij"))
-    mass = model.mass_kg(dv_left)
-    tau = np.log1p(life * model.step_nu(mass) / NU_REF)
-    point = model.point(label, tau)
-    n = label.size
-    alive = life > 0.0
-    rewards, matrices = [], []
-    for burn in config.burn_sizes_m_s:
-        next_label, next_life, next_dv, reward = model.step(point, mass, burn)
-        index, weight = _interpolation(axes, next_label, next_life, next_dv)
-        keep = (weight > 0.0) & alive[:, None]
-        rows = np.broadcast_to(np.arange(n)[:, None], index.shape)[keep]
-        matrices.append(sp.csr_matrix((weight[keep], (rows, index[keep])), shape=(n, n)))
-        rewards.append(np.where(alive, reward, 0.0))
+    n, plane, unit_rows = axes.size, axes.plane, axes.unit_levels * axes.plane
+    horizon = config.horizon_steps
+    has_coast = 0.0 in config.burn_sizes_m_s
+    certain = _coast_certain_stages(model) if has_coast else 0
+    rows = np.array([0] + [(k * axes.life_per_step + 1) * plane if k <= certain else n for k in range(1, horizon + 1)])
+    rewards, matrices, tail_coast = _transitions(model, axes, int(rows.max()))
     if progress:
         print(f"dp: {n} states x {len(rewards)} actions built in {time.perf_counter() - start:.1f} s", file=sys.stderr)
-    horizon = config.horizon_steps
-    # Values are stored as uint16 in steps of VALUE_QUANTUM_DAYS: half of float32's memory
-    # (366 stages of up to a million states), far below the grid's own error.
-    values = np.zeros((horizon + 1, n), dtype=np.uint16)
-    v = np.zeros(n)
+    down = axes.life_per_step * plane
+    # Sums of the coasts' days along the life levels: V_k = C[n] - C[n - k] where n >= k.
+    cumulative = np.zeros(unit_rows, np.float32)
+    if has_coast:
+        levels = rewards[0, :unit_rows].astype(np.float64).reshape(axes.unit_levels, plane)
+        for residue in range(axes.life_per_step):
+            levels[residue :: axes.life_per_step] = np.cumsum(levels[residue :: axes.life_per_step], axis=0)
+        cumulative = levels.ravel().astype(np.float32)
+    offsets = np.concatenate([[0], np.cumsum(rows)[:-1]]).astype(np.int64)
+    # Values are stored as uint16 in steps of VALUE_QUANTUM_DAYS: half of float32's memory,
+    # far below the grid's own error.
+    values = np.zeros(int(rows.sum()), dtype=np.uint16)
+    top = np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS
+    tail_point, _, _, tail_mass = _grid_states(model, axes, np.arange(unit_rows, n))
+    solution = DPSolution(
+        config,
+        density_scale,
+        grid,
+        0.0,
+        model,
+        axes,
+        values,
+        offsets,
+        rows,
+        cumulative,
+        certain,
+        (tail_point, tail_mass),
+    )
+    # The tail's states that a burn from a deciding state lands next to (the others are never read).
+    referenced = max((int(m.indices.max(initial=0)) for m in [*matrices, tail_coast] if m is not None), default=0)
+    tail_rows = np.arange(unit_rows, max(unit_rows, (referenced // plane + 1) * plane))
+    v, new = np.zeros(n, np.float32), np.zeros(n, np.float32)
+    scratch = np.empty(n, np.float32)
     for k in range(1, horizon + 1):
-        v = reduce(np.maximum, [r + p @ v for r, p in zip(rewards, matrices, strict=True)])
-        if v.max() > np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS:
-            raise ValueError(f"values above {np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS:g} days: horizon too long")
-        values[k] = np.rint(np.maximum(v, 0.0) / VALUE_QUANTUM_DAYS)
+        r = int(rows[k])
+        best = new[:r]
+        if has_coast:
+            # Coasts move one life level down (exactly) from the levels up to the horizon + 1.
+            below = min(r, unit_rows)
+            best[:down] = rewards[0, :down]
+            np.add(rewards[0, down:below], v[: below - down], out=best[down:below])
+            if r > unit_rows:
+                np.add(rewards[0, unit_rows:r], tail_coast[: r - unit_rows] @ v, out=best[unit_rows:])
+            burn_rewards = rewards[1:]
+        else:
+            best.fill(-np.inf)
+            burn_rewards = rewards
+        for reward, matrix in zip(burn_rewards, matrices, strict=True):
+            q = _prefix(matrix, r) @ v
+            q += reward[:r]
+            np.maximum(best, q, out=best)
+        if r < n:
+            np.subtract(cumulative[r:unit_rows], cumulative[r - k * down : unit_rows - k * down], out=new[r:unit_rows])
+            new[tail_rows] = solution._coast_days(k, tail_rows)
+        stored = scratch[:r]
+        np.maximum(best, 0.0, out=stored)
+        stored *= 1.0 / VALUE_QUANTUM_DAYS
+        np.rint(stored, out=stored)
+        values[offsets[k] : offsets[k] + r] = stored
+        v, new = new, v
         if progress and k % 73 == 0:
             print(f"dp: stage {k}/{horizon}, {time.perf_counter() - start:.1f} s", file=sys.stderr)
-    return DPSolution(config, density_scale, grid, time.perf_counter() - start, model, axes, values)
+    # The values grow with the steps left (every coast earns >= 0 days): the last stage holds the largest.
+    if v.max(initial=0.0) > top:
+        raise ValueError(f"values above {top:g} days: horizon too long")
+    solution.solve_s = time.perf_counter() - start
+    return solution
 
 
 class DPPolicy:
