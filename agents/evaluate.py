@@ -262,6 +262,11 @@ class ContinuousFromDiscrete:
         return self.actions[np.asarray(index)][..., None], state
 
 
+#: DP grid of each of the oracle's rungs: coarser than ``agents.dp.DEFAULT_GRID``, as the
+#: oracle holds all its rungs' solutions at once.
+ORACLE_GRID = (96, 1, 1)
+
+
 class OracleDP:
     """The optimum told the density: DP solutions on a ladder of density scales.
 
@@ -269,14 +274,22 @@ class OracleDP:
     density scale from the environment and acts by the DP solved at the nearest rung
     (log spacing, ``rungs`` over the scale range). It plans as if that scale then
     stayed constant, so with the slow solar-cycle drift it is a near-optimal
-    reference, not an exact bound.
+    reference, not an exact bound. Each rung's DP is solved on ``grid`` (default
+    :data:`ORACLE_GRID`).
     """
 
-    def __init__(self, config: Any, scale_range: tuple[float, float], rungs: int = 9) -> None:
+    def __init__(
+        self,
+        config: Any,
+        scale_range: tuple[float, float],
+        rungs: int = 9,
+        grid: tuple[int, int, int] | None = None,
+    ) -> None:
         from agents.dp import DPPolicy
 
+        grid = ORACLE_GRID if grid is None else grid
         self.scales = np.geomspace(scale_range[0], scale_range[1], rungs)
-        self.policies = [DPPolicy(config, density_scale=float(s)) for s in self.scales]
+        self.policies = [DPPolicy(config, grid=grid, density_scale=float(s)) for s in self.scales]
         self.env: Any = None
 
     def bind(self, env: Any) -> None:
