@@ -15,12 +15,12 @@ mass and the steps left. The grid uses three coordinates of it:
   follow both neighbours' plans, and the maximum over actions picks those
   errors up stage after stage. So the labels are spaced in proportion to the
   label change of the smallest burn (at the wet mass and ``LABEL_REFERENCE_LIFE``
-  of the horizon), at most ``LABEL_MAX_SPACING`` apart, from ``MU_LOW`` up to
-  where that orbit's apogee reaches ``LABEL_FINE_APOGEE`` of the 4000 km cap;
+  of the horizon) or to ``LABEL_MAX_SPACING`` where that is less, from ``MU_LOW``
+  up to where that orbit's apogee reaches ``LABEL_FINE_APOGEE`` of the 4000 km cap;
   above, where only orbits with very low perigees lie and no burn pays (in 1000
   evaluation episodes the DP policy, the greedy look-ahead and PPO burn below
-  mu = -9.07), the spacing grows
-  geometrically up to the most elongated reachable orbit. Below ``MU_LOW``
+  mu = -9.07), the spacing grows geometrically up to the most elongated
+  reachable orbit. Below ``MU_LOW``
   (e < 1e-7 at re-entry) the orbits are circular to within metres and carry the
   same lifetime (see :mod:`orbit_env.curves`): the value is clamped.
 * n = nu / (K g c s), the lifetime left in steps at the current mass: a coast of
@@ -129,7 +129,8 @@ DEFAULT_GRID = (192, 1, 1)
 VALUE_QUANTUM_DAYS = 0.01
 #: Lowest label on the grid; below it orbits are circular to within metres.
 MU_LOW = -14.0
-#: Widest spacing of the labels (nearly circular orbits, where a burn moves mu most).
+#: Label change above which the labels' spacing stops growing (nearly circular orbits,
+#: where a burn moves mu most).
 LABEL_MAX_SPACING = 0.3
 #: Life (as a fraction of the horizon, at the wet mass) at which the label change of
 #: the smallest burn sets the labels' spacing.
