@@ -1,7 +1,8 @@
 """Where each policy burns: maps over the (perigee, apogee) plane at a full tank.
 
 ``python -m agents.maps --out docs/burn_map.png`` draws the optimum (DP) beside PPO
-at the start of a mission: for every start orbit, the burn the policy asks for.
+and the greedy look-ahead at the start of a mission: for every start orbit, the burn
+the policy asks for.
 """
 
 from __future__ import annotations
@@ -57,7 +58,9 @@ def plot_burn_maps(
     colours = ListedColormap(plt.get_cmap("viridis")(np.linspace(0.0, 1.0, sizes.size)))
     edges = np.concatenate([[sizes[0] - 1.0], (sizes[1:] + sizes[:-1]) / 2, [sizes[-1] + 1.0]])
     norm = BoundaryNorm(edges, colours.N)
-    fig, axes = plt.subplots(1, len(maps), figsize=(5.2 * len(maps), 4.6), dpi=120, sharey=True)
+    fig, axes = plt.subplots(
+        1, len(maps), figsize=(4.6 * len(maps) + 1.0, 4.4), dpi=120, sharey=True, layout="constrained"
+    )
     axes = np.atleast_1d(axes)
     for ax, (name, grid) in zip(axes, maps.items(), strict=True):
         image = ax.pcolormesh(apogee_km, perigee_km, grid, cmap=colours, norm=norm, shading="nearest")
@@ -72,8 +75,8 @@ def plot_burn_maps(
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Draw the DP and PPO burn maps of ``OrbitRaising-v0``."""
-    from agents.evaluate import dp_policy, load_ppo, task_of
+    """Draw the DP, PPO and greedy burn maps of ``OrbitRaising-v0``."""
+    from agents.evaluate import dp_policy, hand_coded_policies, load_ppo, task_of
 
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", default="burn_map.png")
@@ -81,7 +84,11 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     perigee = np.linspace(160.0, 500.0, 69)
     apogee = np.linspace(160.0, 1600.0, 145)
-    policies = {"dp (optimum)": dp_policy(args.env), "ppo": load_ppo(args.env)}
+    policies = {
+        "dp (optimum)": dp_policy(args.env),
+        "ppo": load_ppo(args.env),
+        "greedy": hand_coded_policies(args.env)["greedy"],
+    }
     maps = burn_map(args.env, policies, perigee, apogee)
     sizes = np.asarray(task_of(args.env).config.burn_sizes_m_s)
     plot_burn_maps(maps, perigee, apogee, sizes, args.out)
