@@ -8,7 +8,7 @@ The seeds differ from training's (``agents/ppo.toml`` trains with seed 0).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -136,22 +136,26 @@ def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
     return {name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()}
 
 
-def paired_difference(results: Mapping[str, Episodes], name: str = "ppo") -> dict[str, Any] | None:
-    """``name``'s return minus the best hand-coded policy's, episode by episode (None without them).
+def paired_difference(
+    results: Mapping[str, Episodes], name: str = "ppo", baseline: str | None = None
+) -> dict[str, Any] | None:
+    """``name``'s return minus ``baseline``'s, episode by episode (None if either is missing).
 
-    Both policies meet the same start states, so the per-episode difference has a
-    much smaller spread than either return: its mean and standard error say
-    whether a small lead is more than the luck of these episodes.
+    ``baseline`` None: the best hand-coded policy. Both policies meet the same start
+    states, so the per-episode difference has a much smaller spread than either
+    return: its mean and standard error say whether a small lead is more than the
+    luck of these episodes.
     """
-    baselines = [b for b in HAND_CODED if b in results]
-    if name not in results or not baselines:
+    if baseline is None:
+        candidates = [b for b in HAND_CODED if b in results]
+        baseline = max(candidates, key=lambda b: results[b].returns.mean()) if candidates else None
+    if name not in results or baseline not in results:
         return None
-    best = max(baselines, key=lambda b: results[b].returns.mean())
-    diff = results[name].returns - results[best].returns
+    diff = results[name].returns - results[baseline].returns
     stderr = float(diff.std(ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else float("nan")
     return {
         "policy": name,
-        "baseline": best,
+        "baseline": baseline,
         "mean": float(diff.mean()),
         "stderr": stderr,
         "better": int(np.sum(diff > TIE_DAYS)),
@@ -164,9 +168,9 @@ def format_table(
     episodes: int,
     seed: int,
     table: Mapping[str, Mapping[str, float | None]],
-    paired: Mapping[str, Any] | None = None,
+    paired: Sequence[Mapping[str, Any]] = (),
 ) -> str:
-    """The evaluation as a text table for people (``paired``: from :func:`paired_difference`)."""
+    """The evaluation as a text table for people (``paired``: results of :func:`paired_difference`)."""
     lines = [
         f"{env_id}: {episodes} episodes (seed {seed})",
         f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
@@ -178,11 +182,11 @@ def format_table(
             f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
         )
     lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
-    if paired is not None:
+    for pair in paired:
         lines.append(
-            f"{paired['policy']} - {paired['baseline']} on the same episodes: {paired['mean']:+.2f} +- "
-            f"{paired['stderr']:.2f} days (mean +- standard error); better on {paired['better']}, "
-            f"worse on {paired['worse']} (by more than {TIE_DAYS} day)"
+            f"{pair['policy']} - {pair['baseline']} on the same episodes: {pair['mean']:+.2f} +- "
+            f"{pair['stderr']:.2f} days (mean +- standard error); better on {pair['better']}, "
+            f"worse on {pair['worse']} (by more than {TIE_DAYS} day)"
         )
     return "\n".join(lines)
 

@@ -320,14 +320,18 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
         plot_returns(results, args.env, args.plot)
-    paired = paired_difference(results)
+    # PPO against the best hand-coded policy, then against the optimum.
+    paired = {
+        "paired_difference": paired_difference(results),
+        "paired_to_dp": paired_difference(results, baseline="dp"),
+    }
     if args.json:
         out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}
-        if paired is not None:
-            out["paired_difference"] = paired
+        out.update({key: pair for key, pair in paired.items() if pair is not None})
         print(json.dumps(out))
     else:
-        print(format_table(args.env, args.episodes, args.seed, table, paired))
+        found = [pair for pair in paired.values() if pair is not None]
+        print(format_table(args.env, args.episodes, args.seed, table, found))
     return 0
 
 

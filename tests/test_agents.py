@@ -55,6 +55,9 @@ def test_paired_difference_is_against_the_best_hand_coded_policy(baseline_result
     assert paired["stderr"] == pytest.approx(wobble.std(ddof=1) / np.sqrt(wobble.size))
     assert (paired["better"], paired["worse"]) == ((wobble > 0).sum(), (wobble < 0).sum())
     assert paired_difference(baseline_results) is None  # no ppo
+    to_dp = paired_difference(dict(fake, dp=greedy), baseline="dp")
+    assert to_dp["baseline"] == "dp" and to_dp["mean"] == pytest.approx(wobble.mean())
+    assert paired_difference(fake, baseline="dp") is None  # no dp
 
 
 @pytest.mark.parametrize("cls", [NeverBurn, AllAtOnce, ApogeeThreshold, Greedy])
