@@ -184,10 +184,11 @@ def format_table(
     lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
     for pair in paired:
         lines.append(
-            f"{pair['policy']} - {pair['baseline']} on the same episodes: {pair['mean']:+.2f} +- "
-            f"{pair['stderr']:.2f} days (mean +- standard error); better on {pair['better']}, "
-            f"worse on {pair['worse']} (by more than {TIE_DAYS} day)"
+            f"{pair['policy']} - {pair['baseline']}, paired: {pair['mean']:+.2f} +- {pair['stderr']:.2f} days "
+            f"(mean +- s.e.), better on {pair['better']}, worse on {pair['worse']} episodes"
         )
+    if paired:
+        lines.append(f"paired: episode by episode on the same start states; ties within {TIE_DAYS} day")
     return "\n".join(lines)
 
 
