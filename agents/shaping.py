@@ -22,16 +22,19 @@ Evaluation (``orbit-env evaluate``) always scores the unshaped environment.
 
 Ending decided episodes (``end_decided`` in the training config). Most of a mission
 holds no decision: the satellite already outlives the mission without another burn,
-or the tank is empty (93% of the steps of the shipped agent's episodes). From such a
-state coasting is optimal, so its shaped optimal value is 0 exactly:
+or the tank is empty (93% of the steps of the episodes of the agent shipped before
+this option). From such a state coasting is optimal, so its shaped optimal value is 0:
 
 * with the tank empty nothing can be done;
 * if the satellite outlives the mission, every mission day is already earned and a
   burn can add only through a longer orbital period (the reward counts the days of
-  K revolutions). That gain is at most K x steps left x max dP/dv per m/s, below
-  the propellant's cost for the configs this accepts
-  (:func:`burns_cannot_pay_once_the_mission_is_covered` checks it over the curves'
-  whole domain: 0.30 day per m/s against a cost of 0.4 for the default task).
+  K revolutions). The period a burn adds at once is at most max dP/dv per m/s, worth
+  K x steps left times that, below the propellant's cost for the configs this
+  accepts (:func:`burns_cannot_pay_once_the_mission_is_covered` checks it over the
+  curves' whole domain: 0.30 day per m/s against a cost of 0.4 for the default
+  task). That the decay does not widen the difference later (the raised, lighter
+  satellite decays faster) is checked, not proven: the DP solved with every state
+  free to burn moves no value by more than its interpolation error (docs/dp.md).
 
 So a training episode may end, as terminal, after the step taken from a decided
 state, with the shaped reward r + Phi(s') - Phi(s): the return it is trained on is
