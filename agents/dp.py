@@ -118,8 +118,8 @@ from orbit_env.envs.orbit_raising import (
     coast,
     delta_v_left_m_s,
     perigee_burn,
+    period_gain_days_per_m_s_per_step,
 )
-from orbit_env.orbit import apogee_after_perigee_burn_m, elements_from_heights, period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -295,12 +295,7 @@ def _coast_certain_stages(model: _Model) -> int:
     config = model.config
     if config.delta_v_capacity_m_s <= 0.0 or max(config.burn_sizes_m_s) <= 0.0:
         return config.horizon_steps
-    perigee_m = np.linspace(REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M, 101)
-    step_m_s = 1e-3
-    p, e = elements_from_heights(perigee_m, CURVES_MAX_APOGEE_M)
-    p2, e2 = elements_from_heights(perigee_m, apogee_after_perigee_burn_m(perigee_m, CURVES_MAX_APOGEE_M, step_m_s))
-    rate_s_per_m_s = float(np.max(period_s(p2, e2) - period_s(p, e)) / step_m_s)
-    c0 = config.revolutions_per_step * rate_s_per_m_s / SECONDS_PER_DAY
+    c0 = period_gain_days_per_m_s_per_step(config.revolutions_per_step)
     stages = math.ceil(config.propellant_cost_per_m_s / c0) - 1
     return int(min(max(stages, 0), config.horizon_steps))
 

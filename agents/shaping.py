@@ -52,9 +52,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, SECONDS_PER_DAY
-from orbit_env.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M, CurvePoint, nu_per_revolution, universal_curves
-from orbit_env.envs.orbit_raising import Coast, OrbitRaisingConfig, coast
+from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
+from orbit_env.envs.orbit_raising import Coast, OrbitRaisingConfig, coast, period_gain_days_per_m_s_per_step
 
 FloatArray = NDArray[np.float64]
 
@@ -113,26 +112,13 @@ def outlook(env: Any, observations: NDArray[np.float32]) -> tuple[FloatArray, ND
     return np.maximum(end.days, 0.0), decided
 
 
-def potential(env: Any, observations: NDArray[np.float32]) -> FloatArray:
-    """Phi of every satellite of an orbit-raising vector env (see :func:`outlook`)."""
-    return outlook(env, observations)[0]
-
-
 def period_gain_days_per_m_s(config: OrbitRaisingConfig) -> float:
     """The most mission days a perigee burn can add per m/s by lengthening the period alone.
 
-    dP/dv at perigee is 3 P v_p a / mu (vis-viva and Kepler's third law); its
-    largest value over the curves' domain (perigee 100-1100 km, apogee up to
-    4000 km), times K revolutions for each of the mission's steps.
+    :func:`orbit_env.envs.orbit_raising.period_gain_days_per_m_s_per_step` for each
+    of the mission's steps.
     """
-    perigee_m = np.linspace(100e3, CURVES_MAX_PERIGEE_M, 101)[:, None]
-    apogee_m = np.maximum(np.linspace(100e3, CURVES_MAX_APOGEE_M, 391)[None, :], perigee_m)
-    rp, ra = EARTH_RADIUS_M + perigee_m, EARTH_RADIUS_M + apogee_m
-    a = 0.5 * (rp + ra)
-    period_s = 2.0 * np.pi * np.sqrt(a**3 / MU_EARTH_M3_S2)
-    v_p = np.sqrt(MU_EARTH_M3_S2 * (2.0 / rp - 1.0 / a))
-    dp_dv = 3.0 * period_s * v_p * a / MU_EARTH_M3_S2
-    return float(dp_dv.max()) * config.revolutions_per_step * config.horizon_steps / SECONDS_PER_DAY
+    return period_gain_days_per_m_s_per_step(config.revolutions_per_step) * config.horizon_steps
 
 
 def burns_cannot_pay_once_the_mission_is_covered(config: OrbitRaisingConfig) -> bool:

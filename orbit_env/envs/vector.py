@@ -172,25 +172,21 @@ class OrbitRaisingVectorEnv(VectorEnv):
         super().reset(seed=seed)
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
-        if seed is not None:
-            self._pool_next = self.num_envs  # empty: the next restart draws from the new seed
+        if mask is None or seed is not None:
+            self._pool_next = self.num_envs  # empty: the next restart draws a fresh pool
+        obs = self._last_obs.copy()
         if mask is None:
             idx = np.arange(self.num_envs)
+        else:
+            idx = self._masked(mask)
+            options = {k: v[idx] if np.shape(v) == (self.num_envs,) else v for k, v in options.items()}
+        if mask is not None and not options:
+            obs[idx] = self._restart(idx)  # fresh draws, as an automatic reset's
+        else:
             self._start(idx, options or None)
-            self._has_state = True
-            self._pool_next = self.num_envs
-            zeros = np.zeros(self.num_envs)
-            self._last_obs = self._observe_subset(idx, zeros, zeros)
-            return self._last_obs, {}
-        idx = self._masked(mask)
-        obs = self._last_obs.copy()
-        if options:
-            masked = {k: v[idx] if np.shape(v) == (self.num_envs,) else v for k, v in options.items()}
-            self._start(idx, masked)
             zeros = np.zeros(idx.size)
             obs[idx] = self._observe_subset(idx, zeros, zeros)
-        else:
-            obs[idx] = self._restart(idx)  # fresh draws, as an automatic reset's
+        self._has_state = True
         self._last_obs = obs
         return obs, {}
 
