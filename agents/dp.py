@@ -22,7 +22,7 @@ mass and the steps left. The grid uses three coordinates of it:
   mu = -9.07), the spacing grows geometrically up to the most elongated
   reachable orbit. Below ``MU_LOW``
   (e < 1e-7 at re-entry) the orbits are circular to within metres and carry the
-  same lifetime (see :mod:`orbit_env.curves`): the value is clamped.
+  same lifetime (see :mod:`orbit_env.decay.curves`): the value is clamped.
 * n = nu / (K g c s), the lifetime left in steps at the current mass: a coast of
   one step moves it from n to n - 1 exactly, so with ``life_per_step`` levels per
   unit of n up to the horizon + 1 (and a geometric tail above, where every orbit
@@ -98,11 +98,11 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
+from orbit_env.agents.policies import observation_batch
 from scipy.optimize import brentq
 
-from agents.policies import observation_batch
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
-from orbit_env.curves import (
+from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
     NU_REF,

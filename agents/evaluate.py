@@ -15,9 +15,9 @@ from typing import Any, Protocol
 import gymnasium
 import numpy as np
 from numpy.typing import NDArray
+from orbit_env.agents.policies import HAND_CODED
 
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.policies import HAND_CODED
 from orbit_env.envs import ENV_IDS
 
 FloatArray = NDArray[np.float64]
@@ -194,7 +194,7 @@ def format_table(
 
 def plot_returns(results: Mapping[str, Episodes], env_id: str, path: str) -> None:
     """Box plot of the episode returns of every policy."""
-    from orbit_env.plotting import pyplot
+    from orbit_env.optional import pyplot
 
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5), dpi=120)
@@ -228,7 +228,7 @@ def load_ppo(env_id: str, model_path: str | None = None) -> Predictor | None:
     if model_path is None:
         if env_id not in SHIPPED_MODELS:
             return None
-        path = Path(str(resources.files("agents").joinpath("models", SHIPPED_MODELS[env_id])))
+        path = Path(str(resources.files("orbit_env.agents").joinpath("models", SHIPPED_MODELS[env_id])))
     else:
         path = Path(model_path)
     if not path.is_file():
@@ -267,7 +267,7 @@ class ContinuousFromDiscrete:
         return self.actions[np.asarray(index)][..., None], state
 
 
-#: DP grid of each of the oracle's rungs: coarser than ``agents.dp.DEFAULT_GRID``, as the
+#: DP grid of each of the oracle's rungs: coarser than ``orbit_env.agents.dp.DEFAULT_GRID``, as the
 #: oracle holds all its rungs' solutions at once.
 ORACLE_GRID = (96, 1, 1)
 
@@ -290,7 +290,7 @@ class OracleDP:
         rungs: int = 9,
         grid: tuple[int, int, int] | None = None,
     ) -> None:
-        from agents.dp import DPPolicy
+        from orbit_env.agents.dp import DPPolicy
 
         grid = ORACLE_GRID if grid is None else grid
         self.scales = np.geomspace(scale_range[0], scale_range[1], rungs)
@@ -317,7 +317,7 @@ class OracleDP:
 
 def dp_policy(env_id: str) -> Predictor:
     """The optimum for ``env_id``: DP on the known density, its continuous form, or the oracle."""
-    from agents.dp import DPPolicy
+    from orbit_env.agents.dp import DPPolicy
 
     base = task_of(env_id)
     if base.density.scale_range[0] != base.density.scale_range[1]:

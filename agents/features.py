@@ -7,7 +7,7 @@ to a few weeks) all lie in 0 to 0.08. This extractor passes the observation on
 and appends ln(L / 365 d) = logit(component 4) and ln(1 - t), so that a linear
 layer already forms ln(L / time left). It has no parameters and needs nothing
 but the observation: the environment is unchanged, and a saved model carries
-the class by name (``agents.features``).
+the class by name (``orbit_env.agents.features``).
 """
 
 from __future__ import annotations

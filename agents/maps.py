@@ -1,6 +1,6 @@
 """Where each policy burns: maps over the (perigee, apogee) plane at a full tank.
 
-``python -m agents.maps --out docs/burn_map.png`` draws the optimum (DP) beside PPO
+``python -m orbit_env.agents.maps --out docs/burn_map.png`` draws the optimum (DP) beside PPO
 and the greedy look-ahead at the start of a mission: for every start orbit, the burn
 the policy asks for.
 """
@@ -52,7 +52,7 @@ def plot_burn_maps(
     """Side-by-side maps of the first burn, one colour per burn size."""
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    from orbit_env.plotting import pyplot
+    from orbit_env.optional import pyplot
 
     plt = pyplot()
     colours = ListedColormap(plt.get_cmap("viridis")(np.linspace(0.0, 1.0, sizes.size)))
@@ -76,7 +76,7 @@ def plot_burn_maps(
 
 def main(argv: list[str] | None = None) -> None:
     """Draw the DP, PPO and greedy burn maps of ``OrbitRaising-v0``."""
-    from agents.evaluate import dp_policy, hand_coded_policies, load_ppo, task_of
+    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, load_ppo, task_of
 
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", default="burn_map.png")

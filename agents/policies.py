@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.constants import SECONDS_PER_DAY
-from orbit_env.curves import CURVES_MAX_APOGEE_M, nu_per_revolution, universal_curves
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, nu_per_revolution, universal_curves
 from orbit_env.envs.orbit_raising import (
     DV_SCALE_M_S,
     HEIGHT_SCALE_M,
@@ -23,7 +23,7 @@ from orbit_env.envs.orbit_raising import (
     OrbitRaisingConfig,
     perigee_burn,
 )
-from orbit_env.orbit import dv_for_apogee_m_s
+from orbit_env.physics.orbit import dv_for_apogee_m_s
 
 FloatArray = NDArray[np.float64]
 

@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
+from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs.orbit_raising import Coast, OrbitRaisingConfig, coast, period_gain_days_per_m_s_per_step
 
 FloatArray = NDArray[np.float64]

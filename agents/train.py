@@ -18,7 +18,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from agents.shaping import SHAPINGS
+from orbit_env.agents.shaping import SHAPINGS
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
@@ -63,7 +63,7 @@ def _mission_end_is_terminal(venv: Any) -> Any:
 def load_config(path: str | Path | None = None) -> dict[str, Any]:
     """Read a training config (default: the shipped ``agents/ppo.toml``)."""
     if path is None:
-        text = resources.files("agents").joinpath(DEFAULT_CONFIG).read_text()
+        text = resources.files("orbit_env.agents").joinpath(DEFAULT_CONFIG).read_text()
     else:
         text = Path(path).read_text()
     config = tomllib.loads(text)
@@ -100,7 +100,7 @@ def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
 
 def shipped_model_path() -> Path:
     """Path of the model shipped with the package."""
-    return Path(str(resources.files("agents").joinpath(SHIPPED_MODEL)))
+    return Path(str(resources.files("orbit_env.agents").joinpath(SHIPPED_MODEL)))
 
 
 def train(
@@ -141,7 +141,7 @@ def train(
     if not config.get("bootstrap_at_horizon", True):
         venv = _mission_end_is_terminal(venv)
     if config.get("shaping", "none") == "never_burn_value":
-        from agents.shaping import never_burn_value_shaping
+        from orbit_env.agents.shaping import never_burn_value_shaping
 
         # Before VecNormalize: it scales the shaped reward.
         venv = never_burn_value_shaping(venv, end_decided=float(config.get("end_decided", 0.0)), seed=seed)
@@ -150,7 +150,7 @@ def train(
     activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
     policy_kwargs: dict[str, Any] = {"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation}
     if config["policy"].get("log_features", False):
-        from agents.features import LogFeatures
+        from orbit_env.agents.features import LogFeatures
 
         policy_kwargs["features_extractor_class"] = LogFeatures
     ppo_kwargs = dict(config["ppo"])

@@ -9,9 +9,9 @@ import time
 
 import numpy as np
 
-from orbit_env.curves import UniversalCurves, universal_curves
-from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.table2 import load_table2
+from orbit_env.decay.averaged import DecayModel, integrate_averaged
+from orbit_env.decay.curves import UniversalCurves, universal_curves
+from orbit_env.paper.table2 import load_table2
 
 
 def best_of(repeats: int, function) -> float:
@@ -54,9 +54,9 @@ def main() -> None:
     advance_s = best_of(3, lambda: curves.advance(point, 1000 * 9.81 * 2 * np.pi * 0.0625 / 10))
     print(f"10^6 satellites advanced by a block of revolutions: {advance_s:.3f} s ({advance_s / lookup_s:.2f}x lookup)")
 
-    # 4. Averaged against direct on the same orbit (see orbit_env.direct).
+    # 4. Averaged against direct on the same orbit (see orbit_env.decay.direct).
     try:
-        from orbit_env.direct import integrate_direct
+        from orbit_env.decay.direct import integrate_direct
     except ImportError:
         return
     c = 2.0 * np.pi * 0.25**2 / 10.0

@@ -16,11 +16,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.direct import integrate_direct
-from orbit_env.msis import MsisAtmosphere, _log_density_table
-from orbit_env.propagate import SolarDecayModel, cached_curves, integrate_reference, propagate
-from orbit_env.solar import CycleActivity, unix_days
+from orbit_env.decay.averaged import DecayModel, integrate_averaged
+from orbit_env.decay.chunked import SolarDecayModel, cached_curves, integrate_reference, propagate
+from orbit_env.decay.direct import integrate_direct
+from orbit_env.decay.solar import CycleActivity, unix_days
+from orbit_env.physics.atmosphere.msis import MsisAtmosphere, _log_density_table
 
 INCLINATION_DEG = 51.6
 DRAG_PARAMETER_M2_KG = 2.2 * 0.03 / 4.0  # a 3U cubesat: 4 kg, 0.03 m^2, c_x 2.2

@@ -1,6 +1,6 @@
 """Chunk length and bin step of the time-varying decay against a day-by-day reference.
 
-Prints the lifetime error of ``orbit_env.propagate.propagate`` for several chunk
+Prints the lifetime error of ``orbit_env.decay.chunked.propagate`` for several chunk
 lengths and bin steps against ``integrate_reference`` (averaged equations in time,
 a fresh NRLMSIS profile every day). Needs pymsis; takes a few minutes.
 """
@@ -10,8 +10,8 @@ import time
 
 import numpy as np
 
-from orbit_env.propagate import SolarDecayModel, cached_curves, integrate_reference, propagate
-from orbit_env.solar import CycleActivity, TableActivity, unix_days
+from orbit_env.decay.chunked import SolarDecayModel, cached_curves, integrate_reference, propagate
+from orbit_env.decay.solar import CycleActivity, TableActivity, unix_days
 
 
 def synthetic_table(start_days: float, years: float, seed: int = 7) -> TableActivity:

@@ -6,11 +6,11 @@ Every case uses the same rules:
 
 * solar activity: ``docs/data/solar_daily_1995_2018.csv``, CelesTrak's daily record
   (observed F10.7 of the previous day, its 81-day centred mean, daily Ap), through
-  the time-stepped decay of :mod:`orbit_env.propagate`;
+  the time-stepped decay of :mod:`orbit_env.decay.chunked`;
 * co-rotating air, the orbit's inclination (and the node's local time for the
   Sun-synchronous GOCE), published heights taken as above the equatorial radius;
 * the drag coefficient of the primary prediction from ONE physical model,
-  :mod:`orbit_env.drag` (Sentman 1961, diffuse re-emission with full energy
+  :mod:`orbit_env.physics.drag` (Sentman 1961, diffuse re-emission with full energy
   accommodation, wall 300 K), applied to each satellite's documented shape and
   attitude: spheres by the closed form, GOCE and GRACE as flat panels flown
   nose-first. The gas's temperature and mean molecular mass are NRLMSIS's at the
@@ -31,11 +31,11 @@ from pathlib import Path
 
 import numpy as np
 
-from orbit_env.api import Satellite, lifetime
+from orbit_env.analysis.lifetime import Satellite, lifetime
 from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
-from orbit_env.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
-from orbit_env.msis import geodetic_altitude_m, orbit_samples, require_pymsis
-from orbit_env.solar import TableActivity, read_solar_csv, unix_days
+from orbit_env.decay.solar import TableActivity, read_solar_csv, unix_days
+from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples, require_pymsis
+from orbit_env.physics.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
 
 SOLAR_CSV = Path(__file__).resolve().parent.parent / "docs" / "data" / "solar_daily_1995_2018.csv"
 #: Heights published above the equatorial radius (6378.137 km) are 7.137 km higher above our 6371 km sphere.
@@ -159,8 +159,9 @@ def observed_days(case: Case) -> float:
 def start_gas(case: Case, activity: TableActivity) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """NRLMSIS at the start: density [kg/m^3], temperature [K] and mean molecular mass [kg] over the orbit.
 
-    Samples: the orbit's latitudes and local times (:func:`orbit_env.msis.orbit_samples`) at the mean initial
-    height, on the start date with its indices. Also returns the speed relative to the co-rotating air [m/s].
+    Samples: the orbit's latitudes and local times
+    (:func:`orbit_env.physics.atmosphere.msis.orbit_samples`) at the mean initial height,
+    on the start date with its indices. Also returns the speed relative to the co-rotating air [m/s].
     """
     msis = require_pymsis()
     height_m = (0.5 * (case.perigee_km + case.apogee_km) + EQUATORIAL_OFFSET_KM) * 1e3

@@ -2,8 +2,8 @@
 
 Every error a user can cause ends in one line on stderr and exit status 2.
 Heights are in km here and converted to SI at once; the batch CSV format is in
-:mod:`orbit_env.batch`, the solar CSV format in :mod:`orbit_env.solar`, the
-observations of ``fit-density`` in :mod:`orbit_env.fit`.
+:mod:`orbit_env.analysis.catalogue`, the solar CSV format in :mod:`orbit_env.decay.solar`, the
+observations of ``fit-density`` in :mod:`orbit_env.analysis.density_fit`.
 """
 
 from __future__ import annotations
@@ -16,10 +16,10 @@ import time
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from orbit_env.api import METHODS, Satellite, check_rule, lifetime, make_satellite
-from orbit_env.atmosphere import ExponentialAtmosphere
-from orbit_env.scenario import ATMOSPHERES, Scenario
-from orbit_env.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
+from orbit_env.analysis.lifetime import METHODS, Satellite, check_rule, lifetime, make_satellite
+from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
+from orbit_env.decay.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
+from orbit_env.physics.atmosphere import ExponentialAtmosphere
 
 PROG = "orbit-env"
 
@@ -165,7 +165,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if args.trajectory:
         _write_csv(args.trajectory, result.history.rows())
     if args.plot:
-        from orbit_env.plotting import plot_history
+        from orbit_env.analysis.plots import plot_history
 
         plot_history(result, args.plot)
     if args.json:
@@ -194,7 +194,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
 
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
-    from orbit_env.batch import batch_lifetimes, read_batch, write_records
+    from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
 
     if not args.out:
         raise ValueError("--batch needs --out CSV for the results")
@@ -222,7 +222,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
 
 
 def _cmd_table2(args: argparse.Namespace) -> int:
-    from orbit_env.table2 import compare_table2
+    from orbit_env.paper.table2 import compare_table2
 
     comparison = compare_table2()
     rows = comparison.rows()
@@ -260,7 +260,7 @@ def _cmd_table2(args: argparse.Namespace) -> int:
 
 
 def _cmd_fig2(args: argparse.Namespace) -> int:
-    from orbit_env.plotting import plot_fig2
+    from orbit_env.paper.figures import plot_fig2
 
     out = plot_fig2(args.out)
     print(f"wrote {out}")
@@ -286,7 +286,7 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--f107", type=float, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
     group.add_argument("--f107a", type=float, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
     group.add_argument("--ap", type=float, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
-    group.add_argument("--solar-csv", metavar="CSV", help="msis: F10.7 (f107a, ap) by date (see orbit_env.solar)")
+    group.add_argument("--solar-csv", metavar="CSV", help="msis: F10.7 (f107a, ap) by date (see orbit_env.decay.solar)")
     group.add_argument("--solar-cycle", action="store_true", help="msis: the built-in smooth solar cycle")
     group.add_argument("--cycle-phase", type=float, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
     group.add_argument(
@@ -301,7 +301,7 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from agents.train import train
+    from orbit_env.agents.train import train
 
     result = train(args.config, args.out, total_timesteps=args.timesteps, progress=not args.no_progress)
     print(f"trained {result.timesteps} timesteps in {result.seconds:.0f} s")
@@ -310,7 +310,7 @@ def _cmd_train(args: argparse.Namespace) -> int:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from agents.evaluate import all_policies, evaluate, format_table, paired_difference, plot_returns
+    from orbit_env.agents.evaluate import all_policies, evaluate, format_table, paired_difference, plot_returns
 
     def say(name: str) -> None:
         if not args.json:
@@ -360,7 +360,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_atmosphere_options(life)
     life.add_argument("--rule", type=float, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
-    life.add_argument("--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.batch)")
+    life.add_argument(
+        "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
+    )
     life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
     life.add_argument("--no-progress", action="store_true", help="with --batch: no progress bar")
     life.add_argument("--json", action="store_true", help="print one JSON object")
@@ -396,7 +398,7 @@ def build_parser() -> argparse.ArgumentParser:
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     tr.set_defaults(func=_cmd_train)
 
-    from agents.evaluate import EVAL_EPISODES, EVAL_SEED
+    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED
 
     ev = sub.add_parser("evaluate", help="every policy on the same seeded episodes: when does a burn pay off?")
     ev.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
@@ -415,7 +417,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_fit_density(args: argparse.Namespace) -> int:
-    from orbit_env.fit import fit_density_scale, read_observations
+    from orbit_env.analysis.density_fit import fit_density_scale, read_observations
 
     satellite = _satellite(args)
     scenario = _scenario(args)

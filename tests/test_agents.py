@@ -5,10 +5,17 @@ import json
 import gymnasium
 import numpy as np
 import pytest
+from orbit_env.agents.evaluate import (
+    EVAL_SEED,
+    Episodes,
+    hand_coded_policies,
+    paired_difference,
+    run_episodes,
+    summarize,
+)
+from orbit_env.agents.policies import AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
 
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.evaluate import EVAL_SEED, Episodes, hand_coded_policies, paired_difference, run_episodes, summarize
-from agents.policies import AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
 from orbit_env.cli import main
 from orbit_env.envs.orbit_raising import OrbitRaisingConfig
 
@@ -90,7 +97,7 @@ def test_the_shipped_ppo_beats_the_greedy_look_ahead_on_validation_episodes():
     # +0.73 +- 0.08 days per episode. On these 300 the standard error is about 0.15 day,
     # so a lead above 0 leaves a margin of some 5 standard errors; a changed env (physics,
     # observation) that the model no longer fits fails it.
-    from agents.evaluate import load_ppo
+    from orbit_env.agents.evaluate import load_ppo
 
     greedy = run_episodes("OrbitRaising-v0", Greedy(), episodes=300, seed=777).returns
     ppo = run_episodes("OrbitRaising-v0", load_ppo("OrbitRaising-v0"), episodes=300, seed=777).returns
@@ -99,7 +106,7 @@ def test_the_shipped_ppo_beats_the_greedy_look_ahead_on_validation_episodes():
 
 
 def test_train_smoke(tmp_path):
-    from agents.train import train
+    from orbit_env.agents.train import train
 
     result = train(out_dir=tmp_path, total_timesteps=2048, progress=False)
     assert result.model_path.is_file()
@@ -136,7 +143,7 @@ def test_the_decision_is_not_trivial_on_the_default_task(baseline_results):
     # Issue 4: on OrbitRaising-v0's defaults the optimum must beat both never burning and
     # burning everything at once by at least 10% of return (measured on the 1000 evaluation
     # episodes: +21.2% and +23.1%). The DP policy, evaluated in the env, on the fixture's 60 episodes.
-    from agents.evaluate import dp_policy
+    from orbit_env.agents.evaluate import dp_policy
 
     dp = run_episodes("OrbitRaising-v0", dp_policy("OrbitRaising-v0"), episodes=60, seed=EVAL_SEED).returns.mean()
     assert dp >= 1.10 * baseline_results["never"].returns.mean()

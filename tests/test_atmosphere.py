@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from orbit_env.atmosphere import (
+from orbit_env.physics.atmosphere import (
     RHO100_CALIBRATED_KG_M3,
     ExponentialAtmosphere,
     FunctionAtmosphere,

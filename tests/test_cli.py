@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from orbit_env.api import Satellite, lifetime, make_satellite
+from orbit_env.analysis.lifetime import Satellite, lifetime, make_satellite
 from orbit_env.cli import main
 
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from orbit_env.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M, universal_curves
-from orbit_env.decay import integrate_averaged
+from orbit_env.decay.averaged import integrate_averaged
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M, universal_curves
 
 # The target: interpolation error <= 0.5% against the ODE (DOP853, rtol 1e-9),
 # for lifetimes nu >= 0.1 (Table II's smallest cell is 0.121). Measured: <= 0.06%.

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from orbit_env.api import lifetime
-from orbit_env.atmosphere import RHO100_CALIBRATED_KG_M3, PaperAtmosphere
+from orbit_env.analysis.lifetime import lifetime
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2
-from orbit_env.decay import DecayModel
-from orbit_env.orbit import elements_from_heights
-from orbit_env.table2 import calibrate_rho100, compare_table2
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.paper.table2 import calibrate_rho100, compare_table2
+from orbit_env.physics.atmosphere import RHO100_CALIBRATED_KG_M3, PaperAtmosphere
+from orbit_env.physics.orbit import elements_from_heights
 
 
 def test_circular_orbit_rates_are_closed_form():

@@ -16,11 +16,11 @@ import math
 import numpy as np
 import pytest
 
-from orbit_env.atmosphere import ExponentialAtmosphere, PaperAtmosphere
 from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, G0_M_S2, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M
-from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.direct import initial_state, integrate_direct, osculating_heights_m, state_derivative
-from orbit_env.orbit import elements_from_heights, period_s
+from orbit_env.decay.averaged import DecayModel, integrate_averaged
+from orbit_env.decay.direct import initial_state, integrate_direct, osculating_heights_m, state_derivative
+from orbit_env.physics.atmosphere import ExponentialAtmosphere, PaperAtmosphere
+from orbit_env.physics.orbit import elements_from_heights, period_s
 
 SPHERE_C_M2_KG = 2.0 * math.pi * 0.25**2 / 10.0
 KM = 1e3

@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import gymnasium as gym
 import numpy as np
+import orbit_env.agents.dp as dp
 import pytest
+from orbit_env.agents.dp import DPPolicy, solve
 
-import agents.dp as dp
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.dp import DPPolicy, solve
 from orbit_env.envs.orbit_raising import OrbitRaisingConfig
 
 CONFIG = OrbitRaisingConfig(

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from orbit_env.drag import (
+from orbit_env.physics.drag import (
     ATOMIC_MASS_KG,
     panel_drag_area_m2,
     plate_drag_coefficient,

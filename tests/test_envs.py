@@ -13,7 +13,7 @@ Tolerances, and why:
 * never-burning lifetime: against the curves, the sum of the step rewards is a
   telescoping sum of W = Int P dnu, exact up to rounding (1e-9); against the
   averaged ODE (``integrate_averaged``), the curves' stated interpolation error,
-  0.5% (``orbit_env/curves.py``).
+  0.5% (``orbit_env/decay/curves.py``).
 """
 
 from __future__ import annotations
@@ -33,15 +33,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import orbit_env
-from orbit_env import curves as curves_module
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
-from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
-from orbit_env.decay import integrate_averaged
+from orbit_env.decay import curves as curves_module
+from orbit_env.decay.averaged import integrate_averaged
+from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig, OrbitRaisingEnv, register_envs
 from orbit_env.envs import orbit_raising as orbit_raising_module
 from orbit_env.envs.orbit_raising import DEFAULT_HORIZON_STEPS, OBS_HIGH, delta_v_left_m_s
 from orbit_env.envs.vector import OrbitRaisingVectorEnv
-from orbit_env.orbit import perigee_velocity_m_s
+from orbit_env.physics.orbit import perigee_velocity_m_s
 
 try:  # optional (orbit-env[plot]); without it the picture render modes are not checked
     import matplotlib
@@ -714,7 +714,7 @@ def test_sb3_trains_on_the_vector_env():
 
 
 # --------------------------------------------------------------------------------------
-# The curves' scalar path and batched interpolation (orbit_env/curves.py)
+# The curves' scalar path and batched interpolation (orbit_env/decay/curves.py)
 # --------------------------------------------------------------------------------------
 
 

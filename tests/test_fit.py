@@ -5,13 +5,13 @@ import json
 import numpy as np
 import pytest
 
-from orbit_env.api import Satellite
-from orbit_env.atmosphere import PaperAtmosphere
+from orbit_env.analysis.density_fit import Observations, fit_density_scale, read_observations
+from orbit_env.analysis.lifetime import Satellite
+from orbit_env.analysis.scenario import Scenario
 from orbit_env.cli import main
 from orbit_env.constants import G0_M_S2
-from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.fit import Observations, fit_density_scale, read_observations
-from orbit_env.scenario import Scenario
+from orbit_env.decay.averaged import DecayModel, integrate_averaged
+from orbit_env.physics.atmosphere import PaperAtmosphere
 
 SATELLITE = Satellite(2.2, 100.0, 1.0)
 TRUE_SCALE = 1.7
@@ -69,7 +69,7 @@ def test_reentry_date_gives_the_true_scale(truth):
 
 def test_reentry_under_a_time_varying_scenario():
     pytest.importorskip("pymsis")
-    from orbit_env.solar import CycleActivity, unix_days
+    from orbit_env.decay.solar import CycleActivity, unix_days
 
     scenario = Scenario("msis", activity=CycleActivity(), epoch_days=unix_days("2022-01-01"))
     days, _ = scenario.lifetime_days(300e3, 300e3, SATELLITE.drag_parameter_m2_kg, 51.6, density_scale=0.6)

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from orbit_env.msis import (
+from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
     MSIS_INSTALL_HINT,
     MsisAtmosphere,
@@ -119,9 +119,9 @@ def test_invalid_inputs_name_the_value():
 
 
 def test_curves_cached_per_profile_and_match_the_ode(iss_like):
-    from orbit_env.api import Satellite, lifetime
-    from orbit_env.curves import universal_curves
-    from orbit_env.decay import DecayModel
+    from orbit_env.analysis.lifetime import Satellite, lifetime
+    from orbit_env.decay.averaged import DecayModel
+    from orbit_env.decay.curves import universal_curves
 
     model = DecayModel(iss_like)
     assert universal_curves(model) is universal_curves(DecayModel(MsisAtmosphere(150.0, 150.0, 15.0, 51.6)))
@@ -129,12 +129,12 @@ def test_curves_cached_per_profile_and_match_the_ode(iss_like):
     for perigee, apogee in ((400.0, 400.0), (300.0, 900.0)):
         fast = lifetime(perigee, apogee, satellite=satellite, atmosphere=iss_like, method="curves")
         slow = lifetime(perigee, apogee, satellite=satellite, atmosphere=iss_like, method="averaged")
-        # The curves' stated accuracy against the averaged ODE is 0.5% (orbit_env/curves.py).
+        # The curves' stated accuracy against the averaged ODE is 0.5% (orbit_env/decay/curves.py).
         assert fast.days == pytest.approx(slow.days, rel=5e-3)
 
 
 def test_scale_multiplies_density_and_divides_lifetime(iss_like):
-    from orbit_env.api import Satellite, lifetime
+    from orbit_env.analysis.lifetime import Satellite, lifetime
 
     satellite = Satellite(2.2, 4.0, 0.03)
     base = lifetime(450.0, 450.0, satellite=satellite, atmosphere=iss_like, method="curves")

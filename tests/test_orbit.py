@@ -5,7 +5,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from orbit_env.orbit import (
+from orbit_env.paper.table2 import load_table2
+from orbit_env.physics.orbit import (
     apogee_after_perigee_burn_m,
     dv_for_apogee_m_s,
     elements_from_heights,
@@ -14,7 +15,6 @@ from orbit_env.orbit import (
     perigee_velocity_m_s,
     validate_heights,
 )
-from orbit_env.table2 import load_table2
 
 heights = st.tuples(st.floats(100e3, 2000e3), st.floats(0.0, 40000e3)).map(lambda t: (t[0], t[0] + t[1]))
 

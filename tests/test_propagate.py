@@ -5,10 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from orbit_env.api import Satellite, check_rule, lifetime
-from orbit_env.rule import apogee_speed_m_s, check_disposal_rule, perigee_lowering_dv_m_s
-from orbit_env.scenario import Scenario
-from orbit_env.solar import ConstantActivity, CycleActivity, TableActivity, unix_days
+from orbit_env.analysis.disposal import apogee_speed_m_s, check_disposal_rule, perigee_lowering_dv_m_s
+from orbit_env.analysis.lifetime import Satellite, check_rule, lifetime
+from orbit_env.analysis.scenario import Scenario
+from orbit_env.decay.solar import ConstantActivity, CycleActivity, TableActivity, unix_days
 
 SATELLITE = Satellite(2.2, 100.0, 1.0)
 START = unix_days("2021-06-01")
@@ -20,8 +20,8 @@ def msis():
 
 
 def test_constant_activity_without_season_is_the_fixed_profile(msis):
-    from orbit_env.msis import MsisAtmosphere
-    from orbit_env.propagate import SolarDecayModel, propagate
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+    from orbit_env.physics.atmosphere.msis import MsisAtmosphere
 
     # F10.7 = e^5 and Ap = 12 fall on a bin, so the chunks use the very curves of the fixed profile;
     # only the 0.1 sfu rounding of the indices (< 0.1% in density) and Newton's steps differ.
@@ -38,7 +38,7 @@ def test_constant_activity_without_season_is_the_fixed_profile(msis):
 
 
 def test_vectorized_equals_one_by_one(msis):
-    from orbit_env.propagate import SolarDecayModel, propagate
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
 
     model = SolarDecayModel(CycleActivity(), START, 51.6)
     hp = np.array([250e3, 300e3])
@@ -49,7 +49,7 @@ def test_vectorized_equals_one_by_one(msis):
 
 
 def test_chunked_matches_the_daily_reference_under_storms(msis):
-    from orbit_env.propagate import SolarDecayModel, integrate_reference, propagate
+    from orbit_env.decay.chunked import SolarDecayModel, integrate_reference, propagate
 
     # Daily rows: F10.7 with a 27-day rotation of +-20% and random storms in Ap.
     rng = np.random.default_rng(3)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, EARTH_RADIUS_M, J2_EARTH, MU_EARTH_M3_S2
-from orbit_env.secular import (
+from orbit_env.physics.oblateness import (
     EPSILON_M5_S2,
     node_rate_rad_per_day,
     node_rate_rad_per_rev,

@@ -3,10 +3,10 @@
 import gymnasium
 import numpy as np
 import pytest
+from orbit_env.agents.shaping import coast_to_mission_end, never_burn_value_shaping, period_gain_days_per_m_s
+from orbit_env.agents.train import load_config
 
 import orbit_env  # noqa: F401  (registers the environments)
-from agents.shaping import coast_to_mission_end, never_burn_value_shaping, period_gain_days_per_m_s
-from agents.train import load_config
 from orbit_env.envs.orbit_raising import OrbitRaisingConfig
 from orbit_env.envs.sb3 import make_sb3_vec_env
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from orbit_env.solar import (
+from orbit_env.decay.solar import (
     ConstantActivity,
     CycleActivity,
     TableActivity,

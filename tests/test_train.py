@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 import torch
+from orbit_env.agents.features import LogFeatures
+from orbit_env.agents.train import linear_decay, load_config
 
-from agents.features import LogFeatures
-from agents.train import linear_decay, load_config
 from orbit_env.envs.orbit_raising import LIFETIME_SCALE_DAYS, observation, observation_space
 
 

@@ -2,8 +2,8 @@
 
 SI units inside (m, kg, s, m/s); days only in the reward and km only in the
 config and the reset options, the user's edge. The dynamics are the paper's
-universal curves (:mod:`orbit_env.curves`) and the vis-viva burn of
-:mod:`orbit_env.orbit`; this module adds the spacecraft (rocket equation), the
+universal curves (:mod:`orbit_env.decay.curves`) and the vis-viva burn of
+:mod:`orbit_env.physics.orbit`; this module adds the spacecraft (rocket equation), the
 task (reward, horizon) and the observation. The pure functions here broadcast
 over numpy arrays and also take plain floats, so the single environment
 (:class:`OrbitRaisingEnv`, floats) and the vector environment
@@ -23,7 +23,7 @@ from gymnasium import spaces
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
-from orbit_env.curves import (
+from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
     CurvePoint,
@@ -31,7 +31,7 @@ from orbit_env.curves import (
     nu_per_revolution,
     universal_curves,
 )
-from orbit_env.orbit import apogee_after_perigee_burn_m, elements_from_heights, perigee_velocity_m_s, period_s
+from orbit_env.physics.orbit import apogee_after_perigee_burn_m, elements_from_heights, perigee_velocity_m_s, period_s
 
 FloatArray = NDArray[np.float64]
 

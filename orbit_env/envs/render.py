@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.constants import REENTRY_ALTITUDE_M
-from orbit_env.curves import CURVES_MAX_APOGEE_M, NU_REF, universal_curves
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, NU_REF, universal_curves
 
 #: Lifetimes nu [m^3/(kg s^2)] of the drawn lines of equal lifetime (Eq. 4.3).
 NU_LEVELS = (1.0, 10.0, 100.0, 1e3, 1e4, 1e5)

@@ -18,7 +18,7 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.curves import CurvePoint, nu_per_revolution, universal_curves
+from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs.orbit_raising import (
     DensityConfig,
     OrbitRaisingConfig,

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, J2_EARTH, MU_EARTH_M3_S2, SECONDS_PER_DAY
-from orbit_env.orbit import _first_bad, period_s
+from orbit_env.physics.orbit import _first_bad, period_s
 
 FloatArray = NDArray[np.float64]
 

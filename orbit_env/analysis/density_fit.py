@@ -5,8 +5,8 @@ SI units inside (m, s); observation files and results at the edge in km and days
 The paper notes that the lifetime is nearly inversely proportional to the density
 near the initial perigee, so an observed decay measures the real density. Here the
 measured quantity is a factor s on the chosen model's density (any atmosphere of a
-:class:`orbit_env.scenario.Scenario`). On a fixed profile s enters the decay only
-through time: t = W / (g c s) (``orbit_env.decay``), so the decay follows the
+:class:`orbit_env.analysis.scenario.Scenario`). On a fixed profile s enters the decay only
+through time: t = W / (g c s) (``orbit_env.decay.averaged``), so the decay follows the
 universal curves and s sets how fast.
 
 Two kinds of data:
@@ -43,11 +43,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
+from orbit_env.analysis.scenario import Scenario
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.curves import NU_REF, UniversalCurves
-from orbit_env.orbit import elements_from_heights, period_s
-from orbit_env.scenario import Scenario
-from orbit_env.solar import unix_days
+from orbit_env.decay.curves import NU_REF, UniversalCurves
+from orbit_env.decay.solar import unix_days
+from orbit_env.physics.orbit import elements_from_heights, period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -167,7 +167,7 @@ def fit_density_scale(
 
     Args:
         observations: Observed orbits (the first is the start).
-        satellite: A :class:`orbit_env.api.Satellite` (its drag parameter is used).
+        satellite: A :class:`orbit_env.analysis.lifetime.Satellite` (its drag parameter is used).
         scenario: Atmosphere and activity whose density is scaled.
         inclination_deg: Orbit inclination.
         reentry: Observed re-entry (date, or days on the observations' time axis):

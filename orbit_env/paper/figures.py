@@ -1,33 +1,17 @@
-"""Figures: the paper's Fig. 2 and a satellite's decay history (needs matplotlib).
-
-matplotlib is an optional dependency (``pip install 'orbit-env[plot]'``).
-"""
+"""The paper's Fig. 2: decay curves and lines of equal lifetime (needs matplotlib, the ``plot`` extra)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from orbit_env.api import LifetimeResult
-from orbit_env.curves import NU_REF, universal_curves
-from orbit_env.decay import DecayModel
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.curves import NU_REF, universal_curves
+from orbit_env.optional import pyplot
 
 #: Levels of the lines nu = const drawn in Fig. 2 [m^3/(kg s^2)].
 FIG2_NU_LEVELS = (0.3, 1.0, 3.0, 10.0, 30.0, 100.0, 300.0, 1e3, 3e3, 1e4, 3e4)
-
-
-def pyplot() -> Any:
-    """Import matplotlib's pyplot for files (Agg backend), or say which extra to install."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as error:  # pragma: no cover - depends on the installation
-        raise ImportError("plotting needs matplotlib: pip install 'orbit-env[plot]'") from error
-    return plt
 
 
 def fig2_curves(
@@ -89,29 +73,6 @@ def plot_fig2(path: str | Path, model: DecayModel | None = None) -> Path:
         fontsize=10,
     )
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out)
-    plt.close(fig)
-    return out
-
-
-def plot_history(result: LifetimeResult, path: str | Path) -> Path:
-    """Perigee and apogee against time for one decay."""
-    plt = pyplot()
-    history = result.history
-    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=120)
-    ax.plot(history.days, history.apogee_km, label="apogee")
-    ax.plot(history.days, history.perigee_km, label="perigee")
-    ax.set_xlabel("days since start")
-    ax.set_ylabel("height [km]")
-    ax.set_title(
-        f"{result.perigee_km:g} x {result.apogee_km:g} km: {result.days:.1f} days, "
-        f"{result.revolutions:.0f} revolutions ({result.method})",
-        fontsize=10,
-    )
-    ax.grid(alpha=0.3)
-    ax.legend()
     fig.tight_layout()
     out = Path(path)
     fig.savefig(out)

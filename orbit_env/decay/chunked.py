@@ -1,6 +1,6 @@
 """Decay under solar activity that changes over the lifetime, on the universal curves. SI units.
 
-The universal curves (:mod:`orbit_env.curves`) belong to one fixed density profile.
+The universal curves (:mod:`orbit_env.decay.curves`) belong to one fixed density profile.
 NRLMSIS's profile changes with F10.7, Ap and the season, over days to years, so a
 decay that spans a solar cycle cannot follow one family of curves. We step the
 satellites through time in chunks (``chunk_days``, default 20 days); in each chunk
@@ -22,7 +22,7 @@ satellites through time in chunks (``chunk_days``, default 20 days); in each chu
    The ratio is tabulated every 50 km with 6 x 6 latitude and local-time nodes
    (numerator and denominator alike, so the coarser sampling cancels);
 4. the satellite moves along its curve by the chunk's time: W = Int P dnu falls by
-   dt g c s (``orbit_env.decay``), solved for nu by Newton's method with
+   dt g c s (``orbit_env.decay.averaged``), solved for nu by Newton's method with
    dW/dnu = P (the Keplerian period). If W left is smaller, it re-enters within
    the chunk, at t + W / (g c s).
 
@@ -43,11 +43,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
-from orbit_env.atmosphere import FunctionAtmosphere
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
-from orbit_env.curves import NU_REF, UniversalCurves
-from orbit_env.decay import DecayModel
-from orbit_env.msis import (
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.curves import NU_REF, UniversalCurves
+from orbit_env.decay.solar import SolarActivity, day_of_year
+from orbit_env.physics.atmosphere import FunctionAtmosphere
+from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
     SEASON_NODES,
     MsisAtmosphere,
@@ -55,8 +56,7 @@ from orbit_env.msis import (
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
 )
-from orbit_env.orbit import elements_from_heights, heights_from_elements, period_s
-from orbit_env.solar import SolarActivity, day_of_year
+from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -120,14 +120,14 @@ class SolarDecayModel:
     """What a decay under changing solar activity depends on, apart from the satellite.
 
     Args:
-        activity: Indices against time (:mod:`orbit_env.solar`).
+        activity: Indices against time (:mod:`orbit_env.decay.solar`).
         start_days: Unix days of the start (the epoch of the orbit).
         inclination_deg: Orbit inclination (latitudes of the NRLMSIS average,
             and the co-rotating air if ``rotating_atmosphere``).
         follow_season: Use each chunk's day of the year (else the year's average).
         rotating_atmosphere: Let the air co-rotate with the Earth.
         ascending_node_local_time_h: For Sun-synchronous orbits (see
-            :class:`orbit_env.msis.MsisAtmosphere`).
+            :class:`orbit_env.physics.atmosphere.msis.MsisAtmosphere`).
         chunk_days: Length of a time step.
         bin_step: Bin width in ln(81-day mean F10.7).
         max_years: Stop propagating after this long.
@@ -330,7 +330,7 @@ def integrate_reference(
     profile (orbit-averaged NRLMSIS at the day's indices and day of year) is
     recomputed every ``profile_step_days`` and its logarithm interpolated
     linearly in time; dp/dt and de/dt are the averaged rates of
-    :mod:`orbit_env.decay` times dnu/dt = g c / P. Slow: ~25 ms per profile.
+    :mod:`orbit_env.decay.averaged` times dnu/dt = g c / P. Slow: ~25 ms per profile.
     """
     profiles: dict[int, FloatArray] = {}
 

@@ -44,8 +44,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
-from orbit_env.decay import DecayModel, period_weight_s
-from orbit_env.orbit import _first_bad, validate_heights
+from orbit_env.decay.averaged import DecayModel, period_weight_s
+from orbit_env.physics.orbit import _first_bad, validate_heights
 
 FloatArray = NDArray[np.float64]
 

@@ -40,10 +40,10 @@ import numpy as np
 from numpy.typing import NDArray
 from tqdm import tqdm
 
-from orbit_env.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
-from orbit_env.orbit import MAX_APOGEE_M
-from orbit_env.rule import check_disposal_rule
-from orbit_env.scenario import Scenario
+from orbit_env.analysis.disposal import check_disposal_rule
+from orbit_env.analysis.scenario import Scenario
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
+from orbit_env.physics.orbit import MAX_APOGEE_M
 
 FloatArray = NDArray[np.float64]
 

@@ -13,15 +13,15 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.atmosphere import Atmosphere, PaperAtmosphere
+from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
+from orbit_env.analysis.scenario import Scenario
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
-from orbit_env.decay import DecayModel, integrate_averaged
-from orbit_env.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
-from orbit_env.propagate import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
-from orbit_env.rule import RuleCheck, check_disposal_rule
-from orbit_env.scenario import Scenario
-from orbit_env.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
+from orbit_env.decay.averaged import DecayModel, integrate_averaged
+from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
+from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
+from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
+from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
+from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
 
 FloatArray = NDArray[np.float64]
 Method = Literal["averaged", "curves", "direct"]
@@ -211,10 +211,10 @@ def lifetime(
         inclination_deg: Orbit inclination (matters with a rotating atmosphere,
             and sets the latitudes NRLMSIS is averaged over).
         activity: Use NRLMSIS 2.1 under this solar activity
-            (:mod:`orbit_env.solar`; needs pymsis). Constant activity without an
+            (:mod:`orbit_env.decay.solar`; needs pymsis). Constant activity without an
             epoch is one fixed profile (every method); otherwise the satellite is
             stepped through time on the universal curves (``method="curves"``,
-            :mod:`orbit_env.propagate`) or, as a slow reference, by the averaged
+            :mod:`orbit_env.decay.chunked`) or, as a slow reference, by the averaged
             equations with a fresh profile every day (``method="averaged"``).
         epoch: Date of the orbit (``YYYY-MM-DD``, or unix days). With NRLMSIS it
             makes the season count, and places the orbit in time-varying activity.
@@ -240,7 +240,7 @@ def lifetime(
         if activity is None:
             raise ValueError("an epoch needs a solar activity (e.g. ConstantActivity(f107, f107a, ap))")
         if isinstance(activity, ConstantActivity) and epoch is None:
-            from orbit_env.msis import MsisAtmosphere
+            from orbit_env.physics.atmosphere.msis import MsisAtmosphere
 
             atmosphere = MsisAtmosphere(
                 activity.f107_sfu,
@@ -279,7 +279,7 @@ def lifetime(
     per_nu = satellite.revolutions_per_nu
     to_days = 1.0 / (float(nu_per_revolution(satellite.drag_parameter_m2_kg)) * SECONDS_PER_DAY)
     if method == "direct":
-        from orbit_env.direct import integrate_direct
+        from orbit_env.decay.direct import integrate_direct
 
         direct = integrate_direct(
             hp_m,
@@ -399,7 +399,7 @@ def check_rule(
     """Does the orbit re-enter within ``rule_years`` (e.g. 25 or 5), and the smallest apogee burn that makes it.
 
     Lifetimes come from the universal curves of the scenario (time-stepped if it
-    has an epoch), see :mod:`orbit_env.rule`. Heights must lie in the curves'
+    has an epoch), see :mod:`orbit_env.analysis.disposal`. Heights must lie in the curves'
     domain (perigee <= 1100 km, apogee <= 4000 km).
 
     Example:

@@ -1,6 +1,6 @@
 """Table II of the paper against this package: the reproduction and the calibration.
 
-Table II (shipped as ``orbit_env/data/table2.csv``) gives the universal lifetime
+Table II (shipped as ``orbit_env/paper/data/table2.csv``) gives the universal lifetime
 nu [m^3/(kg s^2)] and the perigee velocity for 351 initial orbits. The paper does
 not print rho1, its density at 100 km; since nu is inversely proportional to it,
 the least-squares fit in log(nu) over all cells has a closed form (the geometric
@@ -28,11 +28,11 @@ from importlib import resources
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.atmosphere import RHO100_CALIBRATED_KG_M3, PaperAtmosphere
 from orbit_env.constants import EARTH_RADIUS_M, REENTRY_ALTITUDE_M
-from orbit_env.curves import universal_curves
-from orbit_env.decay import DecayModel
-from orbit_env.orbit import elements_from_heights, perigee_velocity_m_s
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.curves import universal_curves
+from orbit_env.physics.atmosphere import RHO100_CALIBRATED_KG_M3, PaperAtmosphere
+from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s
 
 FloatArray = NDArray[np.float64]
 
@@ -54,7 +54,7 @@ class Table2:
 
 def load_table2() -> Table2:
     """Read the 351 cells of Table II from the package data."""
-    text = resources.files("orbit_env").joinpath("data/table2.csv").read_text()
+    text = resources.files("orbit_env.paper").joinpath("data/table2.csv").read_text()
     rows = list(csv.DictReader(text.splitlines()))
     column = {key: np.array([float(row[key]) for row in rows]) for key in rows[0]}
     return Table2(column["perigee_km"], column["apogee_km"], column["nu_paper"], column["v_perigee_paper_m_s"])

@@ -10,7 +10,7 @@ the drag acceleration of Eq. (3.2),
     v_rel = v - Omega x r   (co-rotating air, section 5; v_rel = v in still air),
 
 with c = c_x F / m the drag parameter [m^2/kg] and rho any atmosphere of
-:mod:`orbit_env.atmosphere`. It starts at the perigee of the orbit given by its
+:mod:`orbit_env.physics.atmosphere`. It starts at the perigee of the orbit given by its
 perigee and apogee heights, in a plane inclined by i to the equator (the
 ascending node is on the x axis, the perigee at the node), and stops when the
 osculating perigee height, from the energy and the angular momentum, falls to
@@ -37,7 +37,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
-from orbit_env.atmosphere import Atmosphere, as_atmosphere
 from orbit_env.constants import (
     EARTH_RADIUS_M,
     EARTH_ROTATION_RAD_S,
@@ -45,7 +44,8 @@ from orbit_env.constants import (
     REENTRY_ALTITUDE_M,
     TWO_PI,
 )
-from orbit_env.orbit import elements_from_heights, period_s, validate_heights
+from orbit_env.physics.atmosphere import Atmosphere, as_atmosphere
+from orbit_env.physics.orbit import elements_from_heights, period_s, validate_heights
 
 FloatArray = NDArray[np.float64]
 

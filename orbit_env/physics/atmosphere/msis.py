@@ -40,7 +40,7 @@ the model's own uncertainty (~15%).
 
 The indices are held fixed: F10.7 of the day before (``f107_sfu``), its 81-day
 centred mean (``f107a_sfu``) and the daily Ap (``ap``), all seven Ap slots equal.
-For activity that changes over a lifetime see :mod:`orbit_env.solar`.
+For activity that changes over a lifetime see :mod:`orbit_env.decay.solar`.
 
 Table: ``ALTITUDE_GRID_M`` (40-6000 km, 2 km steps where the scale height is short;
 below 40 km the 40 km value is held: no decay computed here reaches that low);
@@ -49,7 +49,7 @@ relative error is below 1e-3 from 150 to 1000 km and below 4e-3 elsewhere,
 measured in ``tests/test_msis.py``),
 and extrapolated above the grid with its top slope. Building a table costs about
 0.3 s (~600 000 NRLMSIS points) and is cached per condition, so the universal
-curves of :mod:`orbit_env.curves` can be built and cached per profile too.
+curves of :mod:`orbit_env.decay.curves` can be built and cached per profile too.
 
 Nothing is downloaded: all indices are given explicitly to ``pymsis``.
 """
@@ -263,7 +263,7 @@ def interpolate_log_density(altitude_m: ArrayLike, log_rho: FloatArray) -> Float
 class MsisAtmosphere:
     """NRLMSIS 2.1 averaged over an orbit, at fixed solar and geomagnetic activity.
 
-    Frozen and hashable: :func:`orbit_env.curves.universal_curves` caches the
+    Frozen and hashable: :func:`orbit_env.decay.curves.universal_curves` caches the
     curves per instance, and the density table is cached per condition.
 
     Args:

@@ -48,7 +48,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
-from orbit_env.atmosphere import Atmosphere, PaperAtmosphere
 from orbit_env.constants import (
     EARTH_RADIUS_M,
     EARTH_ROTATION_RAD_S,
@@ -56,7 +55,8 @@ from orbit_env.constants import (
     MU_EARTH_M3_S2,
     REENTRY_ALTITUDE_M,
 )
-from orbit_env.orbit import elements_from_heights, heights_from_elements, period_s
+from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
+from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
 FloatArray = NDArray[np.float64]
 

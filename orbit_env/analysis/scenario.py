@@ -4,7 +4,7 @@ SI units inside. A :class:`Scenario` turns the user's choice (the paper's law, a
 exponential law, or NRLMSIS under constant, tabulated or cyclic activity) into
 lifetimes of arrays of satellites through the fast paths: the universal curves of
 one fixed profile, or, when the activity changes over the lifetime (or the season
-is to be followed), the chunked curves of :mod:`orbit_env.propagate`.
+is to be followed), the chunked curves of :mod:`orbit_env.decay.chunked`.
 """
 
 from __future__ import annotations
@@ -16,12 +16,12 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.atmosphere import Atmosphere, ExponentialAtmosphere, PaperAtmosphere
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.curves import UniversalCurves, universal_curves
-from orbit_env.decay import DecayModel
-from orbit_env.propagate import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, cached_curves, propagate
-from orbit_env.solar import ConstantActivity, CycleActivity, SolarActivity, TableActivity, iso_date
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, cached_curves, propagate
+from orbit_env.decay.curves import UniversalCurves, universal_curves
+from orbit_env.decay.solar import ConstantActivity, CycleActivity, SolarActivity, TableActivity, iso_date
+from orbit_env.physics.atmosphere import Atmosphere, ExponentialAtmosphere, PaperAtmosphere
 
 FloatArray = NDArray[np.float64]
 AtmosphereKind = Literal["paper", "exponential", "msis"]
@@ -92,7 +92,7 @@ class Scenario:
             return PaperAtmosphere() if self.rho100_kg_m3 is None else PaperAtmosphere(self.rho100_kg_m3)
         if self.atmosphere == "exponential":
             return ExponentialAtmosphere(self.rho0_kg_m3, self.h0_m, self.scale_height_m)
-        from orbit_env.msis import MsisAtmosphere
+        from orbit_env.physics.atmosphere.msis import MsisAtmosphere
 
         solar = self.solar
         assert isinstance(solar, ConstantActivity)

@@ -1,0 +1,23 @@
+"""Upper-atmosphere density models, one module per model.
+
+* :mod:`~orbit_env.physics.atmosphere.base`: the :class:`Atmosphere` protocol and
+  :func:`as_atmosphere` (a user's function of altitude).
+* :mod:`~orbit_env.physics.atmosphere.paper`: the paper's law, Eq. (1.1) with Table 1.
+* :mod:`~orbit_env.physics.atmosphere.exponential`: an isothermal exponential law.
+* :mod:`~orbit_env.physics.atmosphere.msis`: NRLMSIS 2.1 through ``pymsis``, orbit-averaged
+  (imported on use: it needs the ``msis`` extra).
+"""
+
+from orbit_env.physics.atmosphere.base import Atmosphere, FunctionAtmosphere, as_atmosphere
+from orbit_env.physics.atmosphere.exponential import ExponentialAtmosphere
+from orbit_env.physics.atmosphere.paper import RHO100_CALIBRATED_KG_M3, PaperAtmosphere, paper_delta
+
+__all__ = [
+    "RHO100_CALIBRATED_KG_M3",
+    "Atmosphere",
+    "ExponentialAtmosphere",
+    "FunctionAtmosphere",
+    "PaperAtmosphere",
+    "as_atmosphere",
+    "paper_delta",
+]
