@@ -815,6 +815,8 @@ def test_observation_bounds_cover_the_curves():
 
 def test_segments_follow_the_interpolation_across_cells():
     """Kept segments give table B's bilinear values (to round-off) while tau falls through many cells."""
+    from orbit_env.decay.curves import _DTAU
+
     curves = universal_curves()
     rng = np.random.default_rng(3)
     perigee = rng.uniform(150e3, 900e3, 500)
@@ -831,7 +833,10 @@ def test_segments_follow_the_interpolation_across_cells():
         np.testing.assert_allclose(moved.mean_period_s, plain.mean_period_s, rtol=1e-12)
         np.testing.assert_allclose(perigee_m, plain_perigee, rtol=1e-12)
         np.testing.assert_allclose(apogee_m, plain_apogee, rtol=1e-12)
-        np.testing.assert_array_equal(segments, curves.segments(moved.label, moved.tau))  # refreshed where moved
+        # Refreshed where moved: every kept cell is the one of table B (tau step _DTAU) that holds
+        # its orbit's tau, so the kept line is the bilinear form's own (1e-9 cells: round-off).
+        offset = moved.tau / _DTAU - segments[0]
+        assert np.all((offset >= -1e-9) & (offset <= 1.0 + 1e-9))
         cells_moved += int(np.count_nonzero(segments[0] != before))
         point = moved
     assert cells_moved > 1000  # the test did cross cells

@@ -123,11 +123,6 @@ class DecayModel:
         return factor * dp, factor * de
 
 
-def period_weight_s(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
-    """dW/dnu = the Keplerian period [s]: time = W / (g c s) for any satellite."""
-    return period_s(p_m, e)
-
-
 @dataclass(frozen=True)
 class Trajectory:
     """A decay history, from the start (index 0) to re-entry (last index).
@@ -172,7 +167,8 @@ def integrate_averaged(
         e = max(state[0], 0.0)
         dp_dnu, de_dnu = model.rates_per_nu(p, e)
         dnu_dp = 1.0 / float(dp_dnu)
-        return [float(de_dnu) * dnu_dp, dnu_dp, float(period_weight_s(p, e)) * dnu_dp]
+        # dW/dnu is the Keplerian period: time = W / (g c s) for any satellite.
+        return [float(de_dnu) * dnu_dp, dnu_dp, float(period_s(p, e)) * dnu_dp]
 
     def reentry(p: float, state: FloatArray) -> float:
         return p / (1.0 + max(state[0], 0.0)) - EARTH_RADIUS_M - REENTRY_ALTITUDE_M

@@ -44,8 +44,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
-from orbit_env.decay.averaged import DecayModel, period_weight_s
-from orbit_env.physics.orbit import _first_bad, validate_heights
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.physics.orbit import _first_bad, period_s, validate_heights
 
 FloatArray = NDArray[np.float64]
 
@@ -285,7 +285,7 @@ class UniversalCurves:
             q = weighted / nu
         # At re-entry W/nu is the period itself.
         e_end = np.exp(self.labels)
-        q[:, 0] = period_weight_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
+        q[:, 0] = period_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
         label0 = float(self.labels[0])
         self._table_a = _Grid(self._build_table_a(hp, y, tau), REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
         table_b = self._build_table_b(hp, y, q)
@@ -299,7 +299,7 @@ class UniversalCurves:
         dp_dnu, de_dnu = self.model.rates_per_nu(p, e)
         dhp_dnu = (dp_dnu * (1.0 + e) - p * de_dnu) / (1.0 + e) ** 2
         assert np.all(dhp_dnu < 0.0), "perigee height must fall monotonically under drag"
-        return np.stack([-dhp_dnu, -de_dnu / e, period_weight_s(p, e)]) * dnu_dtau
+        return np.stack([-dhp_dnu, -de_dnu / e, period_s(p, e)]) * dnu_dtau
 
     def _integrate(self, tau: FloatArray, labels: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """RK4 in tau, backward from re-entry, all curves at once.
@@ -417,7 +417,16 @@ class UniversalCurves:
     def locate_segments(
         self, perigee_m: ArrayLike, apogee_m: ArrayLike
     ) -> tuple[CurvePoint, FloatArray, FloatArray, FloatArray]:
-        """:meth:`locate_heights` for arrays, and the located orbits' :meth:`segments`."""
+        """:meth:`locate_heights` for arrays, and where the located orbits are on table B.
+
+        The last value (a (7, n) array) is for :meth:`advance_heights` to keep
+        between steps. An orbit coasts along one curve (fixed label) and its tau
+        falls by a small part of a table cell per step (in the env's defaults 4-7%
+        of satellites change cell in a step), so keeping each orbit's cell and the
+        lines the three values follow across it replaces a gather per orbit and
+        step by two operations per value. Locate anew the orbits whose label
+        changed (a burn); cell changes are handled by ``advance_heights``.
+        """
         label, tau = self._label_tau(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
         segments, ty = self._table_b.segments(label, tau)
         perigee, apogee, q = _heights(label, *self._table_b.along(segments, ty))
@@ -456,18 +465,6 @@ class UniversalCurves:
         mu = np.asarray(label, dtype=np.float64)
         return _heights(mu, *self._table_b.values(mu, tau))
 
-    def segments(self, label: FloatArray, tau: FloatArray) -> FloatArray:
-        """Where orbits at (label, tau) are on table B, for :meth:`advance_heights` to keep between steps.
-
-        An orbit coasts along one curve (fixed label) and its tau falls by a small
-        part of a table cell per step (in the env's defaults 4-7% of satellites
-        change cell in a step), so keeping each orbit's cell and the lines the
-        three values follow across it (a (7, n) array) replaces a gather per
-        orbit and step by two operations per value. Make them anew for orbits
-        whose label changed (a burn); cell changes are handled by ``advance_heights``.
-        """
-        return self._table_b.segments(np.asarray(label, dtype=np.float64), np.asarray(tau, dtype=np.float64))[0]
-
     def _after(self, point: CurvePoint, dnu: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The (nu, tau) reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
         if isinstance(point.tau, float) and isinstance(dnu, float):
@@ -489,8 +486,8 @@ class UniversalCurves:
 
         The same as ``advance`` followed by ``at``, in one interpolation: what a
         simulator stepping many orbits and observing their heights needs. With
-        ``segments`` (from :meth:`segments` or :meth:`locate_segments`, for these
-        orbits' labels) the interpolation uses and updates them in place.
+        ``segments`` (from :meth:`locate_segments`, for these orbits' labels) the
+        interpolation uses and updates them in place.
         """
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
