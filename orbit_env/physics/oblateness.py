@@ -54,7 +54,7 @@ def node_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> FloatAr
 
     Args:
         p_m: Parameter (semi-latus rectum) of the orbit [m].
-        inclination_rad: Inclination in [0, pi] [rad].
+        inclination_rad: Inclination [rad], from 0 to pi.
 
     Raises:
         ValueError: ``p_m`` below half the Earth's radius or not finite, or an
@@ -72,7 +72,7 @@ def perigee_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> Floa
 
     Args:
         p_m: Parameter (semi-latus rectum) of the orbit [m].
-        inclination_rad: Inclination in [0, pi] [rad].
+        inclination_rad: Inclination [rad], from 0 to pi.
 
     Raises:
         ValueError: as :func:`node_rate_rad_per_rev`.
