@@ -1,4 +1,4 @@
-"""Solar activity sources: dates, the CSV reader, the smooth cycle, chunk means."""
+"""Solar activity sources: dates, the CSV reader, the smooth cycle."""
 
 import numpy as np
 import pytest
@@ -6,9 +6,7 @@ import pytest
 from orbit_env.decay.solar import (
     ConstantActivity,
     CycleActivity,
-    TableActivity,
     centred_mean,
-    chunk_means,
     day_of_year,
     iso_date,
     read_solar_csv,
@@ -97,14 +95,6 @@ def test_cycle_with_phase():
     assert cycle.indices(at)[1] == pytest.approx(150.0)
     with pytest.raises(ValueError, match="phase"):
         CycleActivity.with_phase(1.5, at)
-
-
-def test_chunk_means():
-    constant = ConstantActivity(120.0, 110.0, 9.0)
-    means = chunk_means(constant, np.array([0.0, 100.0]), 20.0)
-    assert [m.tolist() for m in means] == [[120.0, 120.0], [110.0, 110.0], [9.0, 9.0]]
-    ramp = TableActivity(np.array([0.0, 100.0]), np.array([100.0, 200.0]), np.array([100.0, 200.0]), np.zeros(2))
-    assert chunk_means(ramp, 10.0, 20.0)[0] == pytest.approx(120.0)
 
 
 def test_constant_activity_checks_its_range():

@@ -286,12 +286,3 @@ class CycleActivity:
         shape = _cycle_shape(self.phase(days), self.peak_phase)
         f107 = self.f107_min_sfu + (self.f107_max_sfu - self.f107_min_sfu) * shape
         return f107, f107.copy(), self.ap_min + (self.ap_max - self.ap_min) * shape
-
-
-def chunk_means(activity: SolarActivity, start_days: ArrayLike, length_days: float) -> tuple[FloatArray, ...]:
-    """Mean F10.7, 81-day mean and Ap over chunks [start, start + length), sampled daily."""
-    start = np.asarray(start_days, dtype=np.float64)
-    samples = max(1, math.ceil(length_days))
-    offsets = (np.arange(samples) + 0.5) * (length_days / samples)
-    f107, f107a, ap = activity.indices(start[..., None] + offsets)
-    return f107.mean(axis=-1), f107a.mean(axis=-1), ap.mean(axis=-1)

@@ -57,7 +57,7 @@ Nothing is downloaded: all indices are given explicitly to ``pymsis``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
@@ -316,7 +316,3 @@ class MsisAtmosphere:
     def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
         """Orbit-averaged density [kg/m^3] at altitude [m] above the spherical Earth."""
         return self.scale * interpolate_log_density(altitude_m, self.log_density_table())
-
-    def with_scale(self, scale: float) -> MsisAtmosphere:
-        """The same atmosphere times ``scale`` (shares the cached table)."""
-        return replace(self, scale=scale)
