@@ -51,13 +51,29 @@ def test_exponential_model_and_plain_functions_plug_in():
 
 
 @pytest.mark.parametrize(
-    ("kwargs", "name"),
+    ("kwargs", "message"),
     [
-        ({"rho100_kg_m3": -1.0}, "rho100_kg_m3"),
-        ({"rho100_kg_m3": float("nan")}, "rho100_kg_m3"),
-        ({"scale": 0.0}, "scale"),
+        ({"rho100_kg_m3": -1.0}, "rho100_kg_m3=-1 is out of range; allowed: above 0 kg/m^3"),
+        ({"rho100_kg_m3": float("nan")}, "rho100_kg_m3=nan is not a finite number; allowed: above 0 kg/m^3"),
+        ({"scale": 0.0}, "scale=0 is out of range; allowed: above 0"),
     ],
 )
-def test_paper_atmosphere_rejects_bad_parameters(kwargs, name):
-    with pytest.raises(ValueError, match=name):
+def test_paper_atmosphere_rejects_bad_parameters(kwargs, message):
+    with pytest.raises(ValueError) as info:
         PaperAtmosphere(**kwargs)
+    assert str(info.value) == message
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"rho0_kg_m3": 0.0}, "rho0_kg_m3=0 is out of range; allowed: above 0 kg/m^3"),
+        ({"h0_m": float("inf")}, "h0_m=inf is not a finite number; allowed: a finite number"),
+        ({"scale_height_m": -8500.0}, "scale_height_m=-8500 is out of range; allowed: above 0 m"),
+        ({"scale": -2.0}, "scale=-2 is out of range; allowed: above 0"),
+    ],
+)
+def test_exponential_atmosphere_rejects_bad_parameters(kwargs, message):
+    with pytest.raises(ValueError) as info:
+        ExponentialAtmosphere(**kwargs)
+    assert str(info.value) == message

@@ -107,15 +107,20 @@ def test_orbit_average_converged():
     assert np.allclose(base, fine, rtol=5e-3)
 
 
-def test_invalid_inputs_name_the_value():
-    with pytest.raises(ValueError, match=r"F10\.7"):
-        MsisAtmosphere(10.0, 150.0, 15.0, 51.6)
-    with pytest.raises(ValueError, match="Ap"):
-        MsisAtmosphere(150.0, 150.0, -1.0, 51.6)
-    with pytest.raises(ValueError, match="inclination"):
-        MsisAtmosphere(150.0, 150.0, 15.0, 200.0)
-    with pytest.raises(ValueError, match="day of year"):
-        MsisAtmosphere(150.0, 150.0, 15.0, 51.6, day_of_year=400.0)
+@pytest.mark.parametrize(
+    ("args", "kwargs", "message"),
+    [
+        ((10.0, 150.0, 15.0, 51.6), {}, "f107_sfu=10 is out of range; allowed: 40 to 400 sfu"),
+        ((150.0, 150.0, -1.0, 51.6), {}, "ap=-1 is out of range; allowed: 0 to 400"),
+        ((150.0, 150.0, 15.0, np.float64(200.0)), {}, "inclination_deg=200 is out of range; allowed: 0 to 180 deg"),
+        ((150.0, 150.0, 15.0, 51.6), {"day_of_year": 400.0}, "day_of_year=400 is out of range; allowed: 1 to 367"),
+        ((150.0, 150.0, 15.0, 51.6), {"scale": 0.0}, "scale=0 is out of range; allowed: above 0"),
+    ],
+)
+def test_invalid_inputs_name_the_value(args, kwargs, message):
+    with pytest.raises(ValueError) as info:
+        MsisAtmosphere(*args, **kwargs)
+    assert str(info.value) == message
 
 
 def test_curves_cached_per_profile_and_match_the_ode(iss_like):

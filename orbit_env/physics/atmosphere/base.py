@@ -25,11 +25,6 @@ class Atmosphere(Protocol):
         ...
 
 
-def _check_positive(name: str, value: float) -> None:
-    if not (np.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-
-
 @dataclass(frozen=True)
 class FunctionAtmosphere:
     """Wraps a user's vectorized function ``altitude_m -> density_kg_m3``."""

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.physics.atmosphere.base import _check_positive
+from orbit_env.checks import check_number
 
 
 @dataclass(frozen=True)
@@ -27,11 +27,10 @@ class ExponentialAtmosphere:
     scale: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_positive("rho0_kg_m3", self.rho0_kg_m3)
-        _check_positive("scale_height_m", self.scale_height_m)
-        _check_positive("scale", self.scale)
-        if not np.isfinite(self.h0_m):
-            raise ValueError(f"h0_m must be finite, got {self.h0_m!r}")
+        check_number(self.rho0_kg_m3, "rho0_kg_m3", unit="kg/m^3", low=0.0, low_inclusive=False)
+        check_number(self.h0_m, "h0_m", unit="m")
+        check_number(self.scale_height_m, "scale_height_m", unit="m", low=0.0, low_inclusive=False)
+        check_number(self.scale, "scale", low=0.0, low_inclusive=False)
 
     def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
         """Density [kg/m^3] at altitude [m]."""

@@ -64,6 +64,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, EARTH_RADIUS_M
 
 FloatArray = NDArray[np.float64]
@@ -105,11 +106,6 @@ def require_pymsis() -> Any:
     except ImportError as error:  # pragma: no cover - exercised only without pymsis
         raise ImportError(MSIS_INSTALL_HINT) from error
     return msis
-
-
-def _check_range(name: str, value: float, low: float, high: float) -> None:
-    if not (math.isfinite(value) and low <= value <= high):
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
 
 
 def orbit_samples(
@@ -291,16 +287,16 @@ class MsisAtmosphere:
     scale: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_range("F10.7 (sfu)", self.f107_sfu, *F107_RANGE_SFU)
-        _check_range("81-day mean F10.7 (sfu)", self.f107a_sfu, *F107_RANGE_SFU)
-        _check_range("Ap", self.ap, *AP_RANGE)
-        _check_range("inclination (deg)", self.inclination_deg, 0.0, 180.0)
+        low, high = F107_RANGE_SFU
+        check_number(self.f107_sfu, "f107_sfu", unit="sfu", low=low, high=high)
+        check_number(self.f107a_sfu, "f107a_sfu", unit="sfu", low=low, high=high)
+        check_number(self.ap, "ap", low=AP_RANGE[0], high=AP_RANGE[1])
+        check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
         if self.day_of_year is not None:
-            _check_range("day of year", self.day_of_year, 1.0, 367.0)
+            check_number(self.day_of_year, "day_of_year", low=1.0, high=367.0)
         if self.ascending_node_local_time_h is not None:
-            _check_range("local time of the ascending node (h)", self.ascending_node_local_time_h, 0.0, 24.0)
-        if not (math.isfinite(self.scale) and self.scale > 0.0):
-            raise ValueError(f"scale must be a positive finite number, got {self.scale!r}")
+            check_number(self.ascending_node_local_time_h, "ascending_node_local_time_h", unit="h", low=0.0, high=24.0)
+        check_number(self.scale, "scale", low=0.0, low_inclusive=False)
 
     def log_density_table(self) -> FloatArray:
         """ln(density [kg/m^3]) on ``ALTITUDE_GRID_M``, without ``scale`` (cached)."""

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.physics.atmosphere.base import _check_positive
+from orbit_env.checks import check_number
 
 #: rho1 of Eq. (1.1): least squares in log(nu) over all 351 cells of Table II,
 #: made by :func:`orbit_env.paper.table2.calibrate_rho100` (median of the log residuals
@@ -59,8 +59,8 @@ class PaperAtmosphere:
     scale: float = 1.0
 
     def __post_init__(self) -> None:
-        _check_positive("rho100_kg_m3", self.rho100_kg_m3)
-        _check_positive("scale", self.scale)
+        check_number(self.rho100_kg_m3, "rho100_kg_m3", unit="kg/m^3", low=0.0, low_inclusive=False)
+        check_number(self.scale, "scale", low=0.0, low_inclusive=False)
 
     def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
         """Density [kg/m^3] at altitude [m]."""
