@@ -118,6 +118,7 @@ class InputError(ValueError):
         scale: float = 1.0,
         unit: str | None = None,
         rename: Callable[[str], str] | None = None,
+        show_index: bool = True,
     ) -> str:
         """The message, optionally in a front end's words.
 
@@ -129,11 +130,13 @@ class InputError(ValueError):
                 (and to the value if ``value_text`` is not given).
             unit: The shown unit (default: :attr:`unit`).
             rename: Maps the names of bounds taken from other parameters.
+            show_index: Append the bad element's index to the label (a front end
+                that names the element its own way, say by a date, turns it off).
         """
         rename = rename or (lambda name: name)
         unit = self.unit if unit is None else unit
         label = self.name if label is None else label
-        if self.index is not None:
+        if self.index is not None and show_index:
             label += "[" + ", ".join(str(i) for i in self.index) + "]"
         if value_text is None:
             shown = self.value
@@ -153,20 +156,20 @@ class InputError(ValueError):
             text = f"{head} is not a finite number"
         else:
             text = f"{head} is out of range"
-        allowed = self._allowed(scale, unit, rename)
+        allowed = self._allowed(scale, unit, rename, show_index)
         if allowed:
             text += f"; allowed: {allowed}"
         if self.why:
             text += f" ({self.why})"
         return text
 
-    def _allowed(self, scale: float, unit: str, rename: Callable[[str], str]) -> str:
+    def _allowed(self, scale: float, unit: str, rename: Callable[[str], str], show_index: bool) -> str:
         def bound(value: float | None, name: str | None) -> str:
             assert value is not None
             number = format_number(float(value) * scale)
             if name is None:
                 return number
-            index = "" if self.index is None else "[" + ", ".join(str(i) for i in self.index) + "]"
+            index = "" if self.index is None or not show_index else "[" + ", ".join(str(i) for i in self.index) + "]"
             return f"{rename(name)}{index} ({number})"
 
         low = None if self.low is None else bound(self.low, self.low_name)

@@ -61,7 +61,10 @@ def test_centred_mean_of_a_27_day_wave_is_flat():
         ("day,f107\n2013-10-01,130\n", "'date' column"),
         ("date,f107\n2013-10-02,130\n2013-10-01,131\n", "increasing"),
         ("date,f107\n2013-10-01,abc\n", "line 2"),
-        ("date,f107\n2013-10-01,1000\n", "f107 on 2013-10-01"),
+        (
+            "date,f107\n2013-10-01,130\n2013-10-02,1000\n",
+            r"flux\.csv: f107=1000 on 2013-10-02 is out of range; allowed: 40 to 400 sfu$",
+        ),
         ("date,f107\n", "no rows"),
     ],
 )
@@ -93,10 +96,20 @@ def test_cycle_with_phase():
     cycle = CycleActivity.with_phase(0.4, at)
     assert cycle.phase(at) == pytest.approx(0.4)
     assert cycle.indices(at)[1] == pytest.approx(150.0)
-    with pytest.raises(ValueError, match="phase"):
+    with pytest.raises(ValueError, match=r"^phase=1\.5 is out of range; allowed: 0 to 1$"):
         CycleActivity.with_phase(1.5, at)
 
 
+def test_cycle_bounds_from_other_fields_are_named():
+    with pytest.raises(ValueError) as info:
+        CycleActivity(f107_min_sfu=100.0, f107_max_sfu=90.0)
+    assert str(info.value) == "f107_max_sfu=90 is out of range; allowed: f107_min_sfu (100) to 400 sfu"
+
+
 def test_constant_activity_checks_its_range():
-    with pytest.raises(ValueError, match="Ap"):
-        ConstantActivity(150.0, 150.0, 500.0)
+    with pytest.raises(ValueError) as info:
+        ConstantActivity(150.0, 150.0, np.float64(500.0))
+    assert str(info.value) == "ap=500 is out of range; allowed: 0 to 400"
+    with pytest.raises(ValueError) as info:
+        ConstantActivity(30.0, 150.0, 15.0)
+    assert str(info.value) == "f107_sfu=30 is out of range; allowed: 40 to 400 sfu"

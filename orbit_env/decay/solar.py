@@ -36,6 +36,9 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import InputError, check_array, check_number, format_number
+from orbit_env.physics.atmosphere.msis import AP_RANGE, F107_RANGE_SFU
+
 FloatArray = NDArray[np.float64]
 
 #: Days in the 81-day centred mean of F10.7.
@@ -85,13 +88,6 @@ class SolarActivity(Protocol):
         ...
 
 
-def _check_index(name: str, value: float, low: float, high: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and low <= value <= high):
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}], got {value!r}")
-    return value
-
-
 @dataclass(frozen=True)
 class ConstantActivity:
     """The same F10.7, 81-day mean and Ap at all times."""
@@ -101,9 +97,9 @@ class ConstantActivity:
     ap: float
 
     def __post_init__(self) -> None:
-        _check_index("F10.7 (sfu)", self.f107_sfu, 40.0, 400.0)
-        _check_index("81-day mean F10.7 (sfu)", self.f107a_sfu, 40.0, 400.0)
-        _check_index("Ap", self.ap, 0.0, 400.0)
+        check_number(self.f107_sfu, "f107_sfu", unit="sfu", low=F107_RANGE_SFU[0], high=F107_RANGE_SFU[1])
+        check_number(self.f107a_sfu, "f107a_sfu", unit="sfu", low=F107_RANGE_SFU[0], high=F107_RANGE_SFU[1])
+        check_number(self.ap, "ap", low=AP_RANGE[0], high=AP_RANGE[1])
 
     def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """The constant indices, broadcast to the shape of ``days``."""
@@ -134,16 +130,17 @@ class TableActivity:
             raise ValueError(f"{self.source}: the solar table has no rows")
         if np.any(np.diff(self.days) <= 0):
             raise ValueError(f"{self.source}: dates must be strictly increasing")
-        for name, values, low, high in (
-            ("f107", self.f107_sfu, 40.0, 400.0),
-            ("f107a", self.f107a_sfu, 40.0, 400.0),
-            ("ap", self.ap, 0.0, 400.0),
+        for name, values, unit, (low, high) in (
+            ("f107", self.f107_sfu, "sfu", F107_RANGE_SFU),
+            ("f107a", self.f107a_sfu, "sfu", F107_RANGE_SFU),
+            ("ap", self.ap, "", AP_RANGE),
         ):
-            bad = ~(np.isfinite(values) & (values >= low) & (values <= high))
-            if bad.any():
-                row = int(np.argmax(bad))
-                date = iso_date(self.days[row])
-                raise ValueError(f"{self.source}: {name} on {date} is {values[row]!r}; allowed: {low:g} to {high:g}")
+            try:
+                check_array(values, name, unit=unit, low=low, high=high)
+            except InputError as error:
+                row = error.index[0] if error.index else 0
+                value = f"{format_number(error.value)} on {iso_date(self.days[row])}"
+                raise ValueError(f"{self.source}: {error.message(value_text=value, show_index=False)}") from None
 
     @property
     def start_days(self) -> float:
@@ -263,17 +260,21 @@ class CycleActivity:
     ap_max: float = 15.0
 
     def __post_init__(self) -> None:
-        _check_index("cycle length (days)", self.period_days, 365.0, 40 * 365.25)
-        _check_index("phase of the maximum", self.peak_phase, 0.1, 0.9)
-        _check_index("F10.7 at minimum (sfu)", self.f107_min_sfu, 40.0, 400.0)
-        _check_index("F10.7 at maximum (sfu)", self.f107_max_sfu, self.f107_min_sfu, 400.0)
-        _check_index("Ap at minimum", self.ap_min, 0.0, 400.0)
-        _check_index("Ap at maximum", self.ap_max, self.ap_min, 400.0)
+        check_number(self.minimum_days, "minimum_days", unit="unix days")
+        check_number(self.period_days, "period_days", unit="days", low=365.0, high=40 * 365.25)
+        check_number(self.peak_phase, "peak_phase", low=0.1, high=0.9)
+        low, high = F107_RANGE_SFU
+        check_number(self.f107_min_sfu, "f107_min_sfu", unit="sfu", low=low, high=high)
+        check_number(
+            self.f107_max_sfu, "f107_max_sfu", unit="sfu", low=self.f107_min_sfu, high=high, low_name="f107_min_sfu"
+        )
+        check_number(self.ap_min, "ap_min", low=AP_RANGE[0], high=AP_RANGE[1])
+        check_number(self.ap_max, "ap_max", low=self.ap_min, high=AP_RANGE[1], low_name="ap_min")
 
     @classmethod
     def with_phase(cls, phase: float, at_days: float, **kwargs: float) -> CycleActivity:
         """The cycle that is at ``phase`` (0 = minimum, ``peak_phase`` = maximum) on ``at_days``."""
-        phase = _check_index("cycle phase", phase, 0.0, 1.0)
+        phase = check_number(phase, "phase", low=0.0, high=1.0)
         period = float(kwargs.get("period_days", SOLAR_CYCLE_DAYS))
         return cls(minimum_days=at_days - phase * period, **kwargs)
 
