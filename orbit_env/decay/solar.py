@@ -247,8 +247,10 @@ class CycleActivity:
         minimum_days: Unix days of a solar minimum.
         period_days: Cycle length.
         peak_phase: Fraction of the cycle from the minimum to the maximum.
-        f107_min_sfu, f107_max_sfu: F10.7 at minimum and maximum.
-        ap_min, ap_max: Ap at minimum and maximum.
+        f107_min_sfu: F10.7 at minimum.
+        f107_max_sfu: F10.7 at maximum.
+        ap_min: Ap at minimum.
+        ap_max: Ap at maximum.
     """
 
     minimum_days: float = field(default_factory=lambda: unix_days("2019-12-15"))
