@@ -5,8 +5,9 @@ it keeps the apogee and lowers the perigee (exact vis-viva), the cheapest way to
 shorten the life of a near-circular or eccentric orbit with one burn. Since the
 lifetime grows monotonically with the perigee at a fixed apogee, the smallest burn
 is found by a vectorized search over perigee heights: three passes of
-``CANDIDATES`` heights each, every pass bracketing the highest complying perigee
-16 times more finely (resolution (h_p - 100 km) / 4096, 0.2 km for a 1000 km
+``CANDIDATES`` = 16 heights each, which cut the bracket around the highest
+complying perigee into 17 parts, so every pass brackets it 17 times more finely
+(resolution (h_p - 100 km) / 17^3 = (h_p - 100 km) / 4913, 0.18 km for a 1000 km
 perigee). The perigee reported complies; the burn is rounded up, never down.
 """
 
@@ -68,7 +69,9 @@ class RuleCheck:
 def check_disposal_rule(
     perigee_m: ArrayLike, apogee_m: ArrayLike, rule_years: float, lifetime_days: LifetimeFunction
 ) -> RuleCheck:
-    """Check the rule for each satellite and find the smallest complying apogee burn.
+    """Check the rule for each satellite and find the smallest complying perigee-lowering burn.
+
+    The burn is retrograde, at apogee: it keeps the apogee and lowers the perigee.
 
     Args:
         perigee_m: Perigee heights [m].
