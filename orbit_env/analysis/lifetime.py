@@ -15,14 +15,13 @@ from numpy.typing import NDArray
 
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.checks import check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
-from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
+from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
 
 FloatArray = NDArray[np.float64]
 Method = Literal["averaged", "curves", "direct"]
@@ -32,6 +31,13 @@ METHODS: tuple[str, ...] = ("averaged", "curves", "direct")
 PAPER_SPHERE_DIAMETER_M = 0.5
 PAPER_SPHERE_MASS_KG = 10.0
 PAPER_DRAG_COEFFICIENT = 2.0
+
+
+def _positive(name: str, value: float) -> float:
+    value = float(value)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -49,16 +55,16 @@ class Satellite:
     area_m2: float = math.pi * (PAPER_SPHERE_DIAMETER_M / 2) ** 2
 
     def __post_init__(self) -> None:
-        check_number(self.drag_coefficient, "drag_coefficient", low=0.0, low_inclusive=False)
-        check_number(self.mass_kg, "mass_kg", unit="kg", low=0.0, low_inclusive=False)
-        check_number(self.area_m2, "area_m2", unit="m^2", low=0.0, low_inclusive=False)
+        _positive("drag coefficient c_x", self.drag_coefficient)
+        _positive("mass (kg)", self.mass_kg)
+        _positive("area (m^2)", self.area_m2)
 
     @classmethod
     def from_mass_per_area(
         cls, mass_per_area_kg_m2: float, drag_coefficient: float = PAPER_DRAG_COEFFICIENT
     ) -> Satellite:
         """A satellite given by its transverse load G/F [kg/m^2] (Eq. 4.1)."""
-        mass_kg = check_number(mass_per_area_kg_m2, "mass_per_area_kg_m2", unit="kg/m^2", low=0.0, low_inclusive=False)
+        mass_kg = _positive("mass per area (kg/m^2)", mass_per_area_kg_m2)
         return cls(drag_coefficient=drag_coefficient, mass_kg=mass_kg, area_m2=1.0)
 
     @property
@@ -168,7 +174,7 @@ def make_satellite(
     if (mass_kg is None) != (area_m2 is None):
         raise ValueError("give --mass and --area together (or --mass-per-area alone)")
     if mass_kg is None or area_m2 is None:
-        return Satellite(drag_coefficient=cx)
+        return Satellite(drag_coefficient=_positive("drag coefficient c_x", cx))
     return Satellite(drag_coefficient=cx, mass_kg=mass_kg, area_m2=area_m2)
 
 
@@ -225,9 +231,9 @@ def lifetime(
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    hp_m, ha_m = (float(x) for x in validate_heights_km(perigee_km, apogee_km))
+    hp_m, ha_m = (float(x) for x in validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3))
     satellite = satellite or Satellite()
-    scale = check_number(density_scale, "density_scale", low=0.0, low_inclusive=False)
+    scale = _positive("density scale", density_scale)
     if activity is not None or epoch is not None:
         if atmosphere is not None or rho100_kg_m3 is not None:
             raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
@@ -331,8 +337,10 @@ def lifetime(
 def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
     if epoch is None:
         return activity.start_days if isinstance(activity, TableActivity) else 0.0
-    if not isinstance(epoch, str):
-        return check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD")
+    if isinstance(epoch, (int, float)):
+        if not math.isfinite(epoch):
+            raise ValueError(f"epoch must be a date or a finite number of unix days, got {epoch!r}")
+        return float(epoch)
     return unix_days(epoch)
 
 
@@ -403,7 +411,7 @@ def check_rule(
     """
     satellite = satellite or Satellite()
     scenario = scenario or Scenario()
-    hp_m, ha_m = validate_heights_km(perigee_km, apogee_km)
+    hp_m, ha_m = validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3)
     c = satellite.drag_parameter_m2_kg
     cap_days = (float(rule_years) + 1.0) * 365.25
 
