@@ -400,10 +400,20 @@ def test_reward_is_days_in_orbit_minus_the_propellant_cost():
     env = OrbitRaisingEnv(config)
     env.reset(seed=0, options={"perigee_km": 400.0, "apogee_km": 900.0})
     before = env.state["time_days"]
-    _, reward, _, _, info = env.step(2)
-    days = env.state["time_days"] - before
-    assert 0.9 < days < 1.2  # 16 revolutions of about 96 min
-    assert reward == pytest.approx(days - config.propellant_cost_per_m_s * info["burn_m_s"], rel=1e-12)
+    _, reward, _, _, info = env.step(2)  # 30 m/s at perigee (the tank holds 300)
+    # Independently: the 30 m/s burn at the 400 km perigee by vis-viva, then K = 16
+    # revolutions of the new ellipse by Kepler's third law, P = 2 pi sqrt(a^3 / fM), with
+    # the package's fM = 3.986e14 m^3/s^2 and R = 6371 km. The env steps on the universal
+    # curves, whose located orbit is off by up to 1.3 km in apogee (a period 1.5e-4 off);
+    # the decay in 16 revolutions at 400 km changes the period by less than 1e-5. Hence
+    # 5e-4 in the days, and 1e-3 days in the reward (which is days - 0.4 day/(m/s) x 30 m/s).
+    mu, rp, ra = 3.986e14, 6371e3 + 400e3, 6371e3 + 900e3
+    speed = math.sqrt(2.0 * mu * ra / (rp * (rp + ra))) + 30.0
+    a_m = 1.0 / (2.0 / rp - speed * speed / mu)
+    days = 16 * 2.0 * math.pi * math.sqrt(a_m**3 / mu) / 86400.0
+    assert info["burn_m_s"] == 30.0
+    assert env.state["time_days"] - before == pytest.approx(days, rel=5e-4)
+    assert reward == pytest.approx(days - 0.4 * 30.0, abs=1e-3)
 
 
 # --------------------------------------------------------------------------------------
@@ -632,6 +642,8 @@ def test_solar_cycle_modulates_the_density_in_time():
 
 @needs_matplotlib
 def test_render_modes():
+    import re
+
     env = make("OrbitRaising-v0", render_mode="rgb_array")
     env.reset(seed=0, options={"perigee_km": 250.0, "apogee_km": 500.0})
     for action in (3, 0, 0, 2, 0):
@@ -644,7 +656,27 @@ def test_render_modes():
     text.reset(seed=0, options={"perigee_km": 250.0, "apogee_km": 500.0})
     text.step(3)
     line = text.render()
-    assert "perigee   249.8 km" in line and "burn 100.0 m/s" in line  # one day of decay from 250 km
+    shown = re.search(
+        r"perigee +([\d.]+) km +apogee +([\d.]+) km +delta-v left +([\d.]+) m/s +burn +([\d.]+) m/s", line
+    )
+    assert shown, line
+    perigee_km, apogee_km, dv_left_m_s, burn_m_s = (float(x) for x in shown.groups())
+    assert burn_m_s == 100.0  # action 3
+    # Tsiolkovsky with the default tank: 220 s x g0 x ln(46 kg / 40 kg), less the 100 m/s
+    # burnt; 0.05 m/s: the line's rounding.
+    assert dv_left_m_s == pytest.approx(220.0 * G0_M_S2 * math.log(46.0 / 40.0) - 100.0, abs=0.05)
+    # One step of decay, from the averaged ODE (not the curves the env steps on): the
+    # burn keeps the 250 km perigee and raises the apogee (vis-viva), then 16 revolutions
+    # are nu = 16 g c (Eq. 4.1), c = 2.2 x 1 m^2 / 46 kg. 0.05 km of rounding on the line
+    # plus the curves' round trip, 0.1 km in perigee and 1.3 km in apogee; the decay itself
+    # is 0.2 km in perigee and 5 km in apogee.
+    mu, rp, ra = 3.986e14, 6371e3 + 250e3, 6371e3 + 500e3
+    speed = math.sqrt(2.0 * mu * ra / (rp * (rp + ra))) + 100.0
+    apogee_m = 2.0 / (2.0 / rp - speed * speed / mu) - rp - 6371e3
+    decay = integrate_averaged(250e3, apogee_m, samples=2000)
+    nu = 16 * G0_M_S2 * 2.2 * 1.0 / 46.0
+    assert perigee_km == pytest.approx(np.interp(nu, decay.nu, decay.perigee_m) / 1e3, abs=0.15)
+    assert apogee_km == pytest.approx(np.interp(nu, decay.nu, decay.apogee_m) / 1e3, abs=1.35)
     human = make("OrbitRaising-v0", render_mode="human")
     human.reset(seed=0)
     assert human.render() is None
