@@ -22,8 +22,6 @@ from orbit_env.agents.shaping import SHAPINGS
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
-#: The shipped model, trained by ``orbit-env train`` with :data:`DEFAULT_CONFIG`.
-SHIPPED_MODEL = "models/ppo_orbit_raising.zip"
 
 
 @dataclass(frozen=True)
@@ -96,11 +94,6 @@ def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
     """
     left_at_start = 1.0 - start
     return lambda progress_left: rate * min(1.0, progress_left / left_at_start)
-
-
-def shipped_model_path() -> Path:
-    """Path of the model shipped with the package."""
-    return Path(str(resources.files("orbit_env.agents").joinpath(SHIPPED_MODEL)))
 
 
 def train(
