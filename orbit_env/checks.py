@@ -144,7 +144,9 @@ class InputError(ValueError):
                 shown = float(self.value) * scale
             value_text = format_number(shown)
         head = f"{label} {value_text}" if label.startswith("-") else f"{label}={value_text}"
-        if self.problem == "number":
+        if self.problem == "number" and isinstance(self.value, (str, np.str_)):
+            text = f"{head} is not a number"  # the quotes show it is text
+        elif self.problem == "number":
             if isinstance(self.value, (bool, np.bool_)):
                 kind = "a bool"
             else:

@@ -65,11 +65,16 @@ def test_nan_and_infinities_are_refused_even_without_bounds(value, shown):
 
 @pytest.mark.parametrize(
     ("value", "kind"),
-    [(True, "a bool"), (np.bool_(False), "a bool"), ("400", "str"), (None, "None"), (1j, "complex")],
+    [(True, "a bool"), (np.bool_(False), "a bool"), (None, "None"), (1j, "complex"), ([400], "list")],
 )
 def test_non_numbers_are_refused_by_type(value, kind):
     assert f"is not a number (got {kind})" in _message(check_number, value, "perigee_km", unit="km", low=100)
-    assert _message(check_number, "400", "perigee_km").startswith("perigee_km='400' ")
+
+
+def test_text_is_not_a_number_and_is_shown_quoted():
+    assert _message(check_number, "400", "perigee_km", unit="km", low=100) == (
+        "perigee_km='400' is not a number; allowed: at least 100 km"
+    )
 
 
 def test_counts_must_be_whole():

@@ -14,6 +14,7 @@ from orbit_env.physics.orbit import (
     heights_from_elements,
     perigee_velocity_m_s,
     validate_heights,
+    validate_heights_km,
 )
 
 heights = st.tuples(st.floats(100e3, 2000e3), st.floats(0.0, 40000e3)).map(lambda t: (t[0], t[0] + t[1]))
@@ -51,24 +52,52 @@ def test_burn_and_dv_are_inverse(pair, dv):
         assert float(dv_for_apogee_m_s(hp, ha, new_apogee)) == pytest.approx(dv, abs=1e-6)
 
 
+_PERIGEE_RANGE_M = "allowed: 100000 to 50000000 m (the decay ends at the re-entry height)"
+
+
 @pytest.mark.parametrize(
-    ("hp", "ha", "match"),
+    ("hp", "ha", "message"),
     [
-        (50e3, 800e3, "perigee height 50 km is below the re-entry height"),
-        (500e3, 400e3, "apogee height 400 km is below the perigee"),
-        (float("nan"), 400e3, "perigee height must be a finite"),
-        (300e3, float("inf"), "apogee height must be a finite"),
-        (300e3, 60000e3, "apogee height 60000 km is out of range"),
+        (50e3, 800e3, f"perigee_m=50000 is out of range; {_PERIGEE_RANGE_M}"),
+        (500e3, 400e3, "apogee_m=400000 is out of range; allowed: perigee_m (500000) to 50000000 m"),
+        (float("nan"), 400e3, f"perigee_m=nan is not a finite number; {_PERIGEE_RANGE_M}"),
+        (300e3, float("inf"), "apogee_m=inf is not a finite number; allowed: perigee_m (300000) to 50000000 m"),
+        (300e3, 60000e3, "apogee_m=60000000 is out of range; allowed: perigee_m (300000) to 50000000 m"),
+        (
+            [300e3, 400e3],
+            [500e3, 350e3],
+            "apogee_m[1]=350000 is out of range; allowed: perigee_m[1] (400000) to 50000000 m",
+        ),
     ],
 )
-def test_invalid_heights_name_the_value(hp, ha, match):
-    with pytest.raises(ValueError, match=match):
+def test_invalid_heights_name_the_value(hp, ha, message):
+    with pytest.raises(ValueError) as info:
         validate_heights(hp, ha)
+    assert str(info.value) == message
+
+
+def test_heights_in_km_are_checked_in_km():
+    hp, ha = validate_heights_km(360.5, 800)
+    assert (float(hp), float(ha)) == (360.5e3, 800e3)
+    with pytest.raises(ValueError) as info:
+        validate_heights_km(np.float64(50.0), 800.0)
+    assert str(info.value) == (
+        "perigee_km=50 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)"
+    )
+    with pytest.raises(ValueError) as info:
+        validate_heights_km(400.0, 300.0)
+    assert str(info.value) == "apogee_km=300 is out of range; allowed: perigee_km (400) to 50000 km"
 
 
 def test_target_below_apogee_is_rejected():
-    with pytest.raises(ValueError, match="only raises the apogee"):
+    with pytest.raises(ValueError) as info:
         dv_for_apogee_m_s(300e3, 800e3, 700e3)
+    assert str(info.value) == (
+        "target_apogee_m=700000 is out of range; allowed: at least apogee_m (800000) m "
+        "(a perigee burn only raises the apogee)"
+    )
+    # A target a round-off below the apogee is the apogee: no burn, no error.
+    assert float(dv_for_apogee_m_s(300e3, 800e3, 800e3 - 1e-4)) == 0.0
 
 
 def test_a_burn_to_escape_has_an_unbounded_apogee():

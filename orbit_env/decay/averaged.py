@@ -48,6 +48,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from orbit_env.checks import check_int, check_number
 from orbit_env.constants import (
     EARTH_RADIUS_M,
     EARTH_ROTATION_RAD_S,
@@ -83,10 +84,8 @@ class DecayModel:
     quadrature_points: int = QUADRATURE_POINTS
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.inclination_deg) and 0.0 <= self.inclination_deg <= 180.0):
-            raise ValueError(f"inclination_deg must be in [0, 180], got {self.inclination_deg!r}")
-        if self.quadrature_points < 8:
-            raise ValueError(f"quadrature_points must be >= 8, got {self.quadrature_points!r}")
+        check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
+        check_int(self.quadrature_points, "quadrature_points", low=8)
 
     @property
     def corotation_rad_s(self) -> float:

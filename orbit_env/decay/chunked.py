@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from orbit_env.checks import check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.curves import NU_REF, UniversalCurves
@@ -145,14 +146,10 @@ class SolarDecayModel:
     _bins: dict[tuple[float, float], DecayModel] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.chunk_days) and 0.1 <= self.chunk_days <= 365.0):
-            raise ValueError(f"chunk length must be in [0.1, 365] days, got {self.chunk_days!r}")
-        if not (math.isfinite(self.bin_step) and 0.0 < self.bin_step <= 1.0):
-            raise ValueError(f"bin step must be in (0, 1], got {self.bin_step!r}")
-        if not (math.isfinite(self.max_years) and 0.0 < self.max_years <= 1000.0):
-            raise ValueError(f"max_years must be in (0, 1000], got {self.max_years!r}")
-        if not (math.isfinite(self.inclination_deg) and 0.0 <= self.inclination_deg <= 180.0):
-            raise ValueError(f"inclination must be in [0, 180] deg, got {self.inclination_deg!r}")
+        check_number(self.chunk_days, "chunk_days", unit="days", low=0.1, high=365.0)
+        check_number(self.bin_step, "bin_step", low=0.0, high=1.0, low_inclusive=False)
+        check_number(self.max_years, "max_years", unit="years", low=0.0, high=1000.0, low_inclusive=False)
+        check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
 
     def chunk_condition(self, t_days: float) -> tuple[DailyIndices, tuple[float, float]]:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""

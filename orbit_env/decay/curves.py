@@ -43,9 +43,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
+from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel
-from orbit_env.physics.orbit import _first_bad, period_s, validate_heights
+from orbit_env.physics.orbit import period_s, validate_heights, validate_heights_km
 
 FloatArray = NDArray[np.float64]
 
@@ -258,6 +259,17 @@ class CurvePoint:
         return self
 
 
+def _check_curve_limits(hp: FloatArray, ha: FloatArray, names: tuple[str, str], unit: str, unit_m: float) -> None:
+    for name, values, limit in ((names[0], hp, CURVES_MAX_PERIGEE_M), (names[1], ha, CURVES_MAX_APOGEE_M)):
+        check_array(
+            values,
+            name,
+            unit=unit,
+            high=limit / unit_m,
+            why="the universal curves end there; the averaged ODE goes higher",
+        )
+
+
 class UniversalCurves:
     """The family of decay curves of one :class:`DecayModel`, as lookup tables.
 
@@ -386,16 +398,15 @@ class UniversalCurves:
                 or apogee above ``CURVES_MAX_APOGEE_M``.
         """
         hp, ha = validate_heights(perigee_m, apogee_m)
-        for name, values, limit in (
-            ("perigee", hp, CURVES_MAX_PERIGEE_M),
-            ("apogee", ha, CURVES_MAX_APOGEE_M),
-        ):
-            bad = values > limit
-            if bad.any():
-                raise ValueError(
-                    f"{name} height {_first_bad(values, bad) / 1e3:g} km is outside the universal curves; "
-                    f"allowed: up to {limit / 1e3:g} km (use the averaged ODE for higher orbits)"
-                )
+        _check_curve_limits(hp, ha, ("perigee_m", "apogee_m"), "m", 1.0)
+        return hp, ha
+
+    @staticmethod
+    def check_domain_km(perigee_km: ArrayLike, apogee_km: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """:meth:`check_domain` for heights in km (checked, and named, in km); returns metres."""
+        hp, ha = validate_heights_km(perigee_km, apogee_km)
+        typed = np.broadcast_arrays(np.asarray(perigee_km, dtype=np.float64), np.asarray(apogee_km, dtype=np.float64))
+        _check_curve_limits(*typed, ("perigee_km", "apogee_km"), "km", 1e3)
         return hp, ha
 
     def locate(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> CurvePoint:

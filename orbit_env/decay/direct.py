@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from orbit_env.checks import check_int, check_number
 from orbit_env.constants import (
     EARTH_RADIUS_M,
     EARTH_ROTATION_RAD_S,
@@ -178,15 +179,6 @@ def initial_state(perigee_m: float, apogee_m: float, inclination_deg: float = 0.
     return np.array([r_m, 0.0, 0.0, 0.0, v_m_s * math.cos(inclination_rad), v_m_s * math.sin(inclination_rad), 0.0])
 
 
-def _check_number(name: str, value: float, low: float, high: float, *, low_open: bool = False) -> float:
-    number = float(value)
-    too_low = number <= low if low_open else number < low
-    if not math.isfinite(number) or too_low or number > high:
-        bracket = "(" if low_open else "["
-        raise ValueError(f"{name} must be in {bracket}{low:g}, {high:g}], got {value!r}")
-    return number
-
-
 def integrate_direct(
     perigee_m: float,
     apogee_m: float,
@@ -232,12 +224,13 @@ def integrate_direct(
             f"got shapes {np.shape(perigee_m)} and {np.shape(apogee_m)}"
         )
     hp, ha = (float(v) for v in validate_heights(perigee_m, apogee_m))
-    c_m2_kg = _check_number("drag_parameter_m2_kg", drag_parameter_m2_kg, 0.0, 100.0, low_open=True)
-    inclination = _check_number("inclination_deg", inclination_deg, 0.0, 180.0)
-    max_revs = _check_number("max_revolutions", max_revolutions, 0.0, 1e6, low_open=True)
-    tolerance = _check_number("rtol", rtol, 1e-13, 1e-5)
-    if isinstance(history_points, bool) or not isinstance(history_points, (int, np.integer)) or history_points < 2:
-        raise ValueError(f"history_points must be an integer >= 2, got {history_points!r}")
+    c_m2_kg = check_number(
+        drag_parameter_m2_kg, "drag_parameter_m2_kg", unit="m^2/kg", low=0.0, high=100.0, low_inclusive=False
+    )
+    inclination = check_number(inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
+    max_revs = check_number(max_revolutions, "max_revolutions", low=0.0, high=1e6, low_inclusive=False)
+    tolerance = check_number(rtol, "rtol", low=1e-13, high=1e-5)
+    history_points = check_int(history_points, "history_points", low=2)
     model = as_atmosphere(atmosphere)
 
     y0 = initial_state(hp, ha, inclination)

@@ -23,8 +23,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, J2_EARTH, MU_EARTH_M3_S2, SECONDS_PER_DAY
-from orbit_env.physics.orbit import _first_bad, period_s
+from orbit_env.physics.orbit import period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -32,19 +33,14 @@ FloatArray = NDArray[np.float64]
 EPSILON_M5_S2 = MU_EARTH_M3_S2 * EARTH_EQUATORIAL_RADIUS_M**2 * 1.5 * J2_EARTH
 
 
-def _check_range(name: str, values: ArrayLike, low: float, high: float, *, high_open: bool = False) -> FloatArray:
-    array = np.asarray(values, dtype=np.float64)
-    bad = ~np.isfinite(array) | (array < low) | ((array >= high) if high_open else (array > high))
-    if bad.any():
-        bracket = ")" if high_open else "]"
-        raise ValueError(f"{name} must be in [{low:g}, {high:g}{bracket}, got {_first_bad(array, bad)!r}")
-    return array
-
-
 def _check_p(p_m: ArrayLike) -> FloatArray:
     # Any orbit that does not cut through the Earth; the formulas themselves only
     # need p > 0, but a smaller p is certainly a unit mistake (km for m).
-    return _check_range("p_m", p_m, EARTH_EQUATORIAL_RADIUS_M / 2.0, np.inf, high_open=True)
+    return check_array(p_m, "p_m", unit="m", low=EARTH_EQUATORIAL_RADIUS_M / 2.0, why="p in metres, not km")
+
+
+def _check_inclination(inclination_rad: ArrayLike) -> FloatArray:
+    return check_array(inclination_rad, "inclination_rad", unit="rad", low=0.0, high=np.pi)
 
 
 def node_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> FloatArray:
@@ -61,7 +57,7 @@ def node_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> FloatAr
             inclination outside [0, pi].
     """
     p = _check_p(p_m)
-    inclination = _check_range("inclination_rad", inclination_rad, 0.0, np.pi)
+    inclination = _check_inclination(inclination_rad)
     return -2.0 * np.pi * EPSILON_M5_S2 * np.cos(inclination) / (p * p * MU_EARTH_M3_S2)
 
 
@@ -78,7 +74,7 @@ def perigee_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> Floa
         ValueError: as :func:`node_rate_rad_per_rev`.
     """
     p = _check_p(p_m)
-    cos_i = np.cos(_check_range("inclination_rad", inclination_rad, 0.0, np.pi))
+    cos_i = np.cos(_check_inclination(inclination_rad))
     return np.pi * EPSILON_M5_S2 * (5.0 * cos_i * cos_i - 1.0) / (p * p * MU_EARTH_M3_S2)
 
 
@@ -89,7 +85,7 @@ def revolutions_per_day(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
         ValueError: ``p_m`` as in :func:`node_rate_rad_per_rev`, or e outside [0, 1).
     """
     p = _check_p(p_m)
-    ecc = _check_range("e", e, 0.0, 1.0, high_open=True)
+    ecc = check_array(e, "e", low=0.0, high=1.0, high_inclusive=False, why="an ellipse")
     return SECONDS_PER_DAY / period_s(p, ecc)
 
 

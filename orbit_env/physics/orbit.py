@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, TWO_PI
 
 FloatArray = NDArray[np.float64]
@@ -20,42 +21,45 @@ FloatArray = NDArray[np.float64]
 MAX_APOGEE_M = 50_000e3
 
 
-def _first_bad(values: FloatArray, bad: NDArray[np.bool_]) -> float:
-    return float(np.asarray(values, dtype=np.float64)[np.asarray(bad)].flat[0])
+def _check_heights(
+    perigee: ArrayLike, apogee: ArrayLike, names: tuple[str, str], unit: str, unit_m: float
+) -> tuple[FloatArray, FloatArray]:
+    """The checks of :func:`validate_heights`, in the caller's unit (``unit_m`` metres)."""
+    hp, ha = np.broadcast_arrays(np.asarray(perigee), np.asarray(apogee))
+    hp = check_array(
+        hp,
+        names[0],
+        unit=unit,
+        low=REENTRY_ALTITUDE_M / unit_m,
+        high=MAX_APOGEE_M / unit_m,
+        why="the decay ends at the re-entry height",
+    )
+    ha = check_array(ha, names[1], unit=unit, low=hp, low_name=names[0], high=MAX_APOGEE_M / unit_m)
+    return hp, ha
 
 
 def validate_heights(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """Check perigee and apogee heights and return them as float arrays.
+    """Check perigee and apogee heights [m] and return them as float arrays.
 
     Raises:
-        ValueError: a height is NaN or infinite, the perigee is below the 100 km
-            re-entry height, the apogee is below the perigee or above
-            ``MAX_APOGEE_M``. The message names the value and the range.
+        ValueError: a height is not a finite number, the perigee is below the
+            100 km re-entry height, the apogee is below the perigee or above
+            ``MAX_APOGEE_M``. The message names ``perigee_m``/``apogee_m``, the
+            value (first bad element and its index for arrays) and the range.
     """
-    hp, ha = np.broadcast_arrays(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
-    for name, values in (("perigee", hp), ("apogee", ha)):
-        bad = ~np.isfinite(values)
-        if bad.any():
-            raise ValueError(f"{name} height must be a finite number of km, got {_first_bad(values, bad)!r}")
-    bad = hp < REENTRY_ALTITUDE_M
-    if bad.any():
-        raise ValueError(
-            f"perigee height {_first_bad(hp, bad) / 1e3:g} km is below the re-entry height; "
-            f"allowed: {REENTRY_ALTITUDE_M / 1e3:g} km to {MAX_APOGEE_M / 1e3:g} km"
-        )
-    bad = ha < hp
-    if bad.any():
-        raise ValueError(
-            f"apogee height {_first_bad(ha, bad) / 1e3:g} km is below the perigee height "
-            f"{_first_bad(hp, bad) / 1e3:g} km; the apogee must be >= the perigee"
-        )
-    bad = ha > MAX_APOGEE_M
-    if bad.any():
-        raise ValueError(
-            f"apogee height {_first_bad(ha, bad) / 1e3:g} km is out of range; "
-            f"allowed: perigee to {MAX_APOGEE_M / 1e3:g} km"
-        )
-    return hp, ha
+    return _check_heights(perigee_m, apogee_m, ("perigee_m", "apogee_m"), "m", 1.0)
+
+
+def validate_heights_km(perigee_km: ArrayLike, apogee_km: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """:func:`validate_heights` for heights given in km; returns them in metres.
+
+    The check happens in km, so a message says ``perigee_km=50``, as the caller typed it.
+
+    Raises:
+        ValueError: as :func:`validate_heights`, naming ``perigee_km``/``apogee_km``.
+    """
+    hp, ha = _check_heights(perigee_km, apogee_km, ("perigee_km", "apogee_km"), "km", 1e3)
+    return hp * 1e3, ha * 1e3
 
 
 def elements_from_heights(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -121,11 +125,11 @@ def dv_for_apogee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, target_apogee_m
         ValueError: the heights are invalid, or the target is below the current apogee.
     """
     hp, ha = validate_heights(perigee_m, apogee_m)
-    _, target = validate_heights(hp, target_apogee_m)
-    bad = target < ha - 1e-3  # 1 mm of round-off slack
-    if bad.any():
-        raise ValueError(
-            f"target apogee {_first_bad(target, bad) / 1e3:g} km is below the current apogee "
-            f"{_first_bad(ha, bad) / 1e3:g} km; a perigee burn only raises the apogee"
-        )
+    ha, target = np.broadcast_arrays(ha, check_array(target_apogee_m, "target_apogee_m", unit="m", high=MAX_APOGEE_M))
+    # 1 mm of round-off slack: a target computed to equal the apogee may land just below it.
+    target = np.where((target < ha) & (target >= ha - 1e-3), ha, target)
+    check_array(
+        target, "target_apogee_m", unit="m", low=ha, low_name="apogee_m", why="a perigee burn only raises the apogee"
+    )
+    hp = np.broadcast_to(hp, target.shape)
     return np.maximum(perigee_velocity_m_s(hp, target) - perigee_velocity_m_s(hp, ha), 0.0)
