@@ -1,6 +1,9 @@
 """The ``orbit-env`` command line: lifetimes (one orbit or a CSV batch), rules, density fits, Table II, Fig. 2.
 
-Every error a user can cause ends in one line on stderr and exit status 2.
+Every error a user can cause ends in one line on stderr and exit status 2. An
+error in a value names the flag and the value as typed (``--perigee 50 is out of
+range; allowed: 100 to 50000 km``): the API raises :class:`orbit_env.checks.InputError`
+naming its parameter, and :data:`FLAGS` maps the parameter to the flag at one place.
 Heights are in km here and converted to SI at once; the batch CSV format is in
 :mod:`orbit_env.analysis.catalogue`, the solar CSV format in :mod:`orbit_env.decay.solar`, the
 observations of ``fit-density`` in :mod:`orbit_env.analysis.density_fit`.
@@ -18,6 +21,7 @@ from typing import Any, NoReturn
 
 from orbit_env.analysis.lifetime import METHODS, Satellite, check_rule, lifetime, make_satellite
 from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
+from orbit_env.checks import InputError
 from orbit_env.decay.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
 from orbit_env.physics.atmosphere import ExponentialAtmosphere
 
@@ -49,6 +53,64 @@ def _given(args: argparse.Namespace, name: str) -> bool:
 
 def _flag(name: str) -> str:
     return "--" + name.replace("_", "-")
+
+
+class _Typed(float):
+    """A number from the command line that remembers how it was typed (for messages)."""
+
+    text: str
+
+
+def _number(text: str) -> float:
+    value = _Typed(text)
+    value.text = text.strip()
+    return value
+
+
+_number.__name__ = "number"  # argparse says "invalid number value: 'abc'"
+
+#: The API's parameter names (as :class:`~orbit_env.checks.InputError` gives them) -> the flag's
+#: argparse dest and, for a flag in other units than the parameter, the factor to the flag's unit and
+#: that unit. ``scale`` is an atmosphere's, ``phase`` :meth:`CycleActivity.with_phase`'s.
+FLAGS: dict[str, tuple[str, float, str | None]] = {
+    "perigee_km": ("perigee", 1.0, None),
+    "apogee_km": ("apogee", 1.0, None),
+    "drag_coefficient": ("cx", 1.0, None),
+    "mass_kg": ("mass", 1.0, None),
+    "area_m2": ("area", 1.0, None),
+    "mass_per_area_kg_m2": ("mass_per_area", 1.0, None),
+    "rho100_kg_m3": ("rho100", 1.0, None),
+    "density_scale": ("density_scale", 1.0, None),
+    "scale": ("density_scale", 1.0, None),
+    "rho0_kg_m3": ("rho0", 1.0, None),
+    "h0_m": ("h0_km", 1e-3, "km"),
+    "scale_height_m": ("scale_height_km", 1e-3, "km"),
+    "f107_sfu": ("f107", 1.0, None),
+    "f107a_sfu": ("f107a", 1.0, None),
+    "ap": ("ap", 1.0, None),
+    "phase": ("cycle_phase", 1.0, None),
+    "ascending_node_local_time_h": ("node_local_time", 1.0, None),
+    "chunk_days": ("chunk_days", 1.0, None),
+    "inclination_deg": ("inclination", 1.0, None),
+    "rule_years": ("rule", 1.0, None),
+    "reentry_sigma_days": ("reentry_sigma_days", 1.0, None),
+    "height_sigma_km": ("height_sigma_km", 1.0, None),
+}
+
+
+def _in_flags(error: InputError, args: argparse.Namespace) -> str:
+    """The error in the command line's words: the flag, the value as typed, the flag's unit."""
+    if error.name not in FLAGS or error.index is not None or not hasattr(args, FLAGS[error.name][0]):
+        return str(error)  # not a flag's value (a file's cell, an element of a table)
+    dest, factor, unit = FLAGS[error.name]
+    typed = getattr(args, dest)
+    return error.message(
+        _flag(dest),
+        value_text=typed.text if isinstance(typed, _Typed) else None,
+        scale=factor,
+        unit=unit,
+        rename=lambda name: _flag(FLAGS[name][0]) if name in FLAGS else name,
+    )
 
 
 def _scenario(args: argparse.Namespace) -> Scenario:
@@ -269,34 +331,34 @@ def _cmd_fig2(args: argparse.Namespace) -> int:
 
 def _add_satellite_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("satellite")
-    group.add_argument("--cx", type=float, default=2.0, help="drag coefficient (default 2.0)")
-    group.add_argument("--mass", type=float, metavar="KG", help="mass [kg] (with --area; default the paper's 10 kg)")
-    group.add_argument("--area", type=float, metavar="M2", help="reference area [m^2] (default 0.5 m sphere)")
-    group.add_argument("--mass-per-area", type=float, metavar="KG_M2", help="transverse load G/F [kg/m^2]")
+    group.add_argument("--cx", type=_number, default=2.0, help="drag coefficient (default 2.0)")
+    group.add_argument("--mass", type=_number, metavar="KG", help="mass [kg] (with --area; default the paper's 10 kg)")
+    group.add_argument("--area", type=_number, metavar="M2", help="reference area [m^2] (default 0.5 m sphere)")
+    group.add_argument("--mass-per-area", type=_number, metavar="KG_M2", help="transverse load G/F [kg/m^2]")
 
 
 def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("atmosphere")
     group.add_argument("--atmosphere", choices=ATMOSPHERES, default="paper", help="density model (default paper)")
-    group.add_argument("--rho100", type=float, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
-    group.add_argument("--density-scale", type=float, default=1.0, help="multiply the density (default 1)")
-    group.add_argument("--rho0", type=float, metavar="KG_M3", help="exponential: density at --h0-km (default 1.3)")
-    group.add_argument("--h0-km", type=float, metavar="KM", help="exponential: reference height (default 0)")
-    group.add_argument("--scale-height-km", type=float, metavar="KM", help="exponential: scale height (default 8.5)")
-    group.add_argument("--f107", type=float, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
-    group.add_argument("--f107a", type=float, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
-    group.add_argument("--ap", type=float, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
+    group.add_argument("--rho100", type=_number, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
+    group.add_argument("--density-scale", type=_number, default=1.0, help="multiply the density (default 1)")
+    group.add_argument("--rho0", type=_number, metavar="KG_M3", help="exponential: density at --h0-km (default 1.3)")
+    group.add_argument("--h0-km", type=_number, metavar="KM", help="exponential: reference height (default 0)")
+    group.add_argument("--scale-height-km", type=_number, metavar="KM", help="exponential: scale height (default 8.5)")
+    group.add_argument("--f107", type=_number, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
+    group.add_argument("--f107a", type=_number, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
+    group.add_argument("--ap", type=_number, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
     group.add_argument("--solar-csv", metavar="CSV", help="msis: F10.7 (f107a, ap) by date (see orbit_env.decay.solar)")
     group.add_argument("--solar-cycle", action="store_true", help="msis: the built-in smooth solar cycle")
-    group.add_argument("--cycle-phase", type=float, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
+    group.add_argument("--cycle-phase", type=_number, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
     group.add_argument(
         "--epoch", metavar="DATE", help="msis: the orbit's date: follow the season and the activity from then on"
     )
-    group.add_argument("--node-local-time", type=float, metavar="HOURS", help="msis: Sun-synchronous node local time")
-    group.add_argument("--chunk-days", type=float, default=20.0, help="msis with --epoch: time step (default 20)")
+    group.add_argument("--node-local-time", type=_number, metavar="HOURS", help="msis: Sun-synchronous node local time")
+    group.add_argument("--chunk-days", type=_number, default=20.0, help="msis with --epoch: time step (default 20)")
     group.add_argument("--rotating-atmosphere", action="store_true", help="air co-rotates with the Earth")
     group.add_argument(
-        "--inclination", type=float, default=0.0, metavar="DEG", help="inclination (rotating air; msis latitudes)"
+        "--inclination", type=_number, default=0.0, metavar="DEG", help="inclination (rotating air; msis latitudes)"
     )
 
 
@@ -348,8 +410,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     life = sub.add_parser("lifetime", help="lifetime of a satellite on an orbit, to re-entry at 100 km perigee")
-    life.add_argument("--perigee", type=float, metavar="KM", help="perigee height [km]")
-    life.add_argument("--apogee", type=float, metavar="KM", help="apogee height [km]")
+    life.add_argument("--perigee", type=_number, metavar="KM", help="perigee height [km]")
+    life.add_argument("--apogee", type=_number, metavar="KM", help="apogee height [km]")
     _add_satellite_options(life)
     life.add_argument(
         "--method",
@@ -359,7 +421,7 @@ def build_parser() -> argparse.ArgumentParser:
         "changes in time, where the averaged reference takes minutes)",
     )
     _add_atmosphere_options(life)
-    life.add_argument("--rule", type=float, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
+    life.add_argument("--rule", type=_number, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
     life.add_argument(
         "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
     )
@@ -373,9 +435,9 @@ def build_parser() -> argparse.ArgumentParser:
     fit = sub.add_parser("fit-density", help="density scale factor from an observed decay (the paper's section 4)")
     fit.add_argument("observations", metavar="OBS_CSV", help="observed orbits: date (or days), perigee_km, apogee_km")
     fit.add_argument("--reentry", metavar="DATE", help="observed re-entry date: fit it from the first orbit")
-    fit.add_argument("--reentry-sigma-days", type=float, default=0.5, help="uncertainty of --reentry (default 0.5)")
+    fit.add_argument("--reentry-sigma-days", type=_number, default=0.5, help="uncertainty of --reentry (default 0.5)")
     fit.add_argument(
-        "--height-sigma-km", type=float, default=1.0, help="with --reentry: uncertainty of the first orbit's heights"
+        "--height-sigma-km", type=_number, default=1.0, help="with --reentry: uncertainty of the first orbit's heights"
     )
     _add_satellite_options(fit)
     _add_atmosphere_options(fit)
@@ -451,7 +513,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
-        message = str(error).splitlines()[0] if str(error) else type(error).__name__
+        text = _in_flags(error, args) if isinstance(error, InputError) else str(error)
+        message = text.splitlines()[0] if text else type(error).__name__
         print(f"{PROG}: error: {message}", file=sys.stderr)
         return 2
 

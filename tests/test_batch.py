@@ -47,7 +47,7 @@ def test_cli_exponential_matches_the_api(capsys):
         (["--atmosphere", "msis", "--rho0", "1"], "--rho0 applies to --atmosphere exponential"),
         (["--atmosphere", "msis", "--solar-cycle"], "--solar-cycle needs --epoch"),
         (["--atmosphere", "msis", "--cycle-phase", "0.3"], "--cycle-phase applies to --solar-cycle"),
-        (["--atmosphere", "msis", "--f107", "10"], "F10.7"),
+        (["--atmosphere", "msis", "--f107", "10"], "--f107 10 is out of range; allowed: 40 to 400 sfu"),
         (["--atmosphere", "msis", "--epoch", "2024-13-01"], "cannot read the date"),
         (["--out", "x.csv"], "--out goes with --batch"),
     ],
@@ -135,9 +135,36 @@ def test_batch_matches_single_lifetimes_and_reports_bad_rows(capsys, tmp_path):
             assert float(record["days"]) == pytest.approx(expected[record["name"]], rel=1e-5)
         else:
             assert record["status"] != "ok" and record["days"] == ""
-    assert "below the perigee" in records[2]["status"]
-    assert "outside the universal curves" in records[3]["status"]
-    assert "line 6" in records[4]["status"]
+    assert records[2]["status"] == "line 4: apogee_km=450 is out of range; allowed: perigee_km (500) to 50000 km"
+    assert records[3]["status"] == (
+        "line 5: perigee_km=1200 is out of range; allowed: at most 1100 km "
+        "(the universal curves end there; the averaged ODE goes higher)"
+    )
+    assert records[4]["status"] == "line 6: perigee_km='abc' is not a number"
+
+
+def test_batch_rows_with_bad_numbers_name_the_column_and_the_cell(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_text(
+        "perigee_km,apogee_km,mass_kg,area_m2,mass_per_area_kg_m2,inclination_deg\n"
+        "300,500,0,1,,\n"
+        "300,500,,,0,\n"
+        "300,500,100,1,,200\n"
+        "300,nan,100,1,,\n"
+        "90,500,100,1,,\n"
+        "300,500,100,1,,\n"
+    )
+    out = tmp_path / "out.csv"
+    status, stdout, _ = run(capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress")
+    assert status == 0 and "6 rows" in stdout and "1 with lifetimes" in stdout
+    assert [record["status"] for record in csv.DictReader(open(out))] == [
+        "line 2: mass_kg=0 is out of range; allowed: above 0 kg",
+        "line 3: mass_per_area_kg_m2=0 is out of range; allowed: above 0 kg/m^2",
+        "line 4: inclination_deg=200 is out of range; allowed: 0 to 180 deg",
+        "line 5: apogee_km=nan is not a finite number; allowed: a finite number",
+        "line 6: perigee_km=90 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)",
+        "ok",
+    ]
 
 
 def test_batch_rule_columns(capsys, tmp_path):

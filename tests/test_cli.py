@@ -104,6 +104,102 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv):
     assert err.count("\n") == 1 and "error" in err and "Traceback" not in err
 
 
+_ORBIT = ["lifetime", "--perigee", "400", "--apogee", "400"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["lifetime", "--perigee", "50", "--apogee", "800"],
+            "--perigee 50 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)",
+        ),
+        (
+            ["lifetime", "--perigee", "500", "--apogee", "400.5"],
+            "--apogee 400.5 is out of range; allowed: --perigee (500) to 50000 km",
+        ),
+        (
+            ["lifetime", "--perigee", "1200", "--apogee", "1300", "--method", "curves"],
+            "--perigee 1200 is out of range; allowed: at most 1100 km "
+            "(the universal curves end there; the averaged ODE goes higher)",
+        ),
+        (
+            [*_ORBIT, "--atmosphere", "exponential", "--scale-height-km", "-8.5"],
+            "--scale-height-km -8.5 is out of range; allowed: above 0 km",
+        ),
+        (
+            [*_ORBIT, "--atmosphere", "exponential", "--rho0", "-1"],
+            "--rho0 -1 is out of range; allowed: above 0 kg/m^3",
+        ),
+        (
+            [*_ORBIT, "--atmosphere", "exponential", "--h0-km", "inf"],
+            "--h0-km inf is not a finite number; allowed: a finite number",
+        ),
+        (
+            [*_ORBIT, "--atmosphere", "msis", "--inclination", "200"],
+            "--inclination 200 is out of range; allowed: 0 to 180 deg",
+        ),
+        ([*_ORBIT, "--inclination", "200"], "--inclination 200 is out of range; allowed: 0 to 180 deg"),
+        ([*_ORBIT, "--atmosphere", "msis", "--f107", "1e3"], "--f107 1e3 is out of range; allowed: 40 to 400 sfu"),
+        (
+            [*_ORBIT, "--atmosphere", "msis", "--node-local-time", "25"],
+            "--node-local-time 25 is out of range; allowed: 0 to 24 h",
+        ),
+        (
+            [*_ORBIT, "--atmosphere", "msis", "--solar-cycle", "--epoch", "2020-01-01", "--cycle-phase", "1.5"],
+            "--cycle-phase 1.5 is out of range; allowed: 0 to 1",
+        ),
+        ([*_ORBIT, "--mass", "0", "--area", "1"], "--mass 0 is out of range; allowed: above 0 kg"),
+        ([*_ORBIT, "--mass", "10", "--area", "0.0"], "--area 0.0 is out of range; allowed: above 0 m^2"),
+        ([*_ORBIT, "--mass-per-area", "0"], "--mass-per-area 0 is out of range; allowed: above 0 kg/m^2"),
+        ([*_ORBIT, "--cx", "-1"], "--cx -1 is out of range; allowed: above 0"),
+        ([*_ORBIT, "--rho100", "-3"], "--rho100 -3 is out of range; allowed: above 0 kg/m^3"),
+        ([*_ORBIT, "--density-scale", "0"], "--density-scale 0 is out of range; allowed: above 0"),
+        ([*_ORBIT, "--rule", "0"], "--rule 0 is out of range; allowed: above 0 years"),
+    ],
+)
+def test_bad_values_name_the_flag_and_the_value_as_typed(capsys, argv, message):
+    status, out, err = run(capsys, *argv)
+    assert status == 2 and out == ""
+    assert err == f"orbit-env: error: {message}\n"
+    for internal in ("np.float64", "_m ", "_m=", "_kg_m3", "_deg", "Traceback"):
+        assert internal not in err
+
+
+def test_fit_density_flags_are_named(capsys, tmp_path):
+    observations = tmp_path / "obs.csv"
+    observations.write_text("date,perigee_km,apogee_km\n2020-01-01,300,320\n")
+    argv = ["fit-density", str(observations), "--reentry", "2020-02-01", "--height-sigma-km", "-1"]
+    status, _, err = run(capsys, *argv)
+    assert status == 2
+    assert err == "orbit-env: error: --height-sigma-km -1 is out of range; allowed: at least 0 km\n"
+
+
+def test_fit_density_names_the_bad_observation(capsys, tmp_path):
+    observations = tmp_path / "obs.csv"
+    observations.write_text("days,perigee_km,apogee_km\n0,300,320\n1,300,290\n2,299,300\n")
+    status, _, err = run(capsys, "fit-density", str(observations))
+    assert status == 2
+    assert err == (
+        f"orbit-env: error: {observations}, observation 2: apogee_km=290 is out of range; "
+        "allowed: perigee_km (300) to 50000 km\n"
+    )
+
+
+def test_the_api_names_its_parameters_in_its_units():
+    with pytest.raises(ValueError) as info:
+        lifetime(np.float64(50.0), 800)
+    assert str(info.value) == (
+        "perigee_km=50 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)"
+    )
+    with pytest.raises(ValueError) as info:
+        lifetime(300, 400, density_scale=-1)
+    assert str(info.value) == "density_scale=-1 is out of range; allowed: above 0"
+    with pytest.raises(ValueError) as info:
+        lifetime(300, 400, inclination_deg=np.float64(-150.0))
+    assert str(info.value) == "inclination_deg=-150 is out of range; allowed: 0 to 180 deg"
+
+
 finite = st.floats(allow_nan=True, allow_infinity=True, width=64)
 
 
@@ -127,8 +223,12 @@ def test_lifetime_rises_with_perigee(perigee_km, extra_km, step_km):
 
 
 def test_satellite_validation():
-    with pytest.raises(ValueError, match="mass"):
+    with pytest.raises(ValueError, match=r"^mass_kg=0 is out of range; allowed: above 0 kg$"):
         Satellite(mass_kg=0)
+    with pytest.raises(ValueError, match=r"^area_m2=nan is not a finite number; allowed: above 0 m\^2$"):
+        Satellite(area_m2=float("nan"))
+    with pytest.raises(ValueError, match=r"^drag_coefficient=True is not a number \(got a bool\)"):
+        make_satellite(True)
     with pytest.raises(ValueError, match="not both"):
         make_satellite(2.0, 10.0, 1.0, 50.0)
     # Section 4: for the paper's sphere, 4G / (pi d^2) / (g c_x) is about 2.6.

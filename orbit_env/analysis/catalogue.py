@@ -30,7 +30,6 @@ do not depend on it: one group.
 from __future__ import annotations
 
 import csv
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,8 +41,8 @@ from tqdm import tqdm
 
 from orbit_env.analysis.disposal import check_disposal_rule
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
-from orbit_env.physics.orbit import MAX_APOGEE_M
+from orbit_env.checks import InputError, check_number
+from orbit_env.decay.curves import UniversalCurves
 
 FloatArray = NDArray[np.float64]
 
@@ -63,22 +62,28 @@ class BatchSummary:
     groups: int
 
 
-def _number(row: dict[str, str], key: str) -> float | None:
+def _number(row: dict[str, str], key: str, **bounds: Any) -> float | None:
+    """The cell ``key`` as a number checked against ``bounds`` (see :func:`check_number`); None if empty."""
     text = row.get(key, "")
     if text == "":
         return None
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError(f"{key} must be finite, got {text!r}")
-    return value
+    try:
+        value = float(text)
+    except ValueError:
+        value = text  # check_number refuses it, naming the column and the text
+    return check_number(value, key, **bounds)
+
+
+def _positive(row: dict[str, str], key: str, unit: str = "") -> float | None:
+    return _number(row, key, unit=unit, low=0.0, low_inclusive=False)
 
 
 def _drag_parameter(row: dict[str, str], default_cx: float, default_c: float) -> float:
-    cx = _number(row, "cx")
+    cx = _positive(row, "cx")
     cx = default_cx if cx is None else cx
-    c = _number(row, "drag_parameter_m2_kg")
-    load = _number(row, "mass_per_area_kg_m2")
-    mass, area = _number(row, "mass_kg"), _number(row, "area_m2")
+    c = _positive(row, "drag_parameter_m2_kg", "m^2/kg")
+    load = _positive(row, "mass_per_area_kg_m2", "kg/m^2")
+    mass, area = _positive(row, "mass_kg", "kg"), _positive(row, "area_m2", "m^2")
     if c is not None:
         value = c
     elif load is not None:
@@ -89,9 +94,8 @@ def _drag_parameter(row: dict[str, str], default_cx: float, default_c: float) ->
         raise ValueError("give mass_kg and area_m2 together")
     else:
         value = default_c * (cx / default_cx)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"the drag parameter must be positive, got {value!r}")
-    return value
+    # Positive factors give a positive c; only an overflow or underflow can spoil it.
+    return check_number(value, "drag parameter c_x A / m", unit="m^2/kg", low=0.0, low_inclusive=False)
 
 
 def read_batch(
@@ -113,36 +117,33 @@ def read_batch(
     if not rows:
         raise ValueError(f"{path}: the batch file has no rows")
     n = len(rows)
-    hp, ha, c, inc = (np.full(n, np.nan) for _ in range(4))
+    hp_km, ha_km, c, inc = (np.full(n, np.nan) for _ in range(4))
     status = ["ok"] * n
     for i, row in enumerate(rows):
         try:
             perigee, apogee = _number(row, "perigee_km"), _number(row, "apogee_km")
             if perigee is None or apogee is None:
                 raise ValueError("perigee_km and apogee_km are required")
-            inclination = _number(row, "inclination_deg")
+            inclination = _number(row, "inclination_deg", unit="deg", low=0.0, high=180.0)
             inclination = default_inclination_deg if inclination is None else inclination
-            if not 0.0 <= inclination <= 180.0:
-                raise ValueError(f"inclination {inclination:g} deg is outside [0, 180]")
-            hp[i], ha[i] = perigee * 1e3, apogee * 1e3
+            hp_km[i], ha_km[i] = perigee, apogee
             c[i] = _drag_parameter(row, default_cx, default_c)
             inc[i] = inclination
         except ValueError as error:
             status[i] = f"line {i + 2}: {error}"
-    valid = np.array([s == "ok" for s in status])
-    for i in np.flatnonzero(valid):
-        if hp[i] < 100e3:
-            status[i] = f"perigee {hp[i] / 1e3:g} km is below the 100 km re-entry height"
-        elif ha[i] < hp[i]:
-            status[i] = f"apogee {ha[i] / 1e3:g} km is below the perigee"
-        elif ha[i] > MAX_APOGEE_M:
-            status[i] = f"apogee {ha[i] / 1e3:g} km is above {MAX_APOGEE_M / 1e3:g} km"
-        elif hp[i] > CURVES_MAX_PERIGEE_M or ha[i] > CURVES_MAX_APOGEE_M:
-            status[i] = (
-                f"outside the universal curves (perigee <= {CURVES_MAX_PERIGEE_M / 1e3:g} km, "
-                f"apogee <= {CURVES_MAX_APOGEE_M / 1e3:g} km); use orbit-env lifetime --method averaged"
-            )
-    return rows, hp, ha, c, inc, status
+    # Heights in the curves' domain, checked a block at a time; a failing block row by row,
+    # so every bad row gets its own message.
+    readable = np.flatnonzero([s == "ok" for s in status])
+    for block in np.array_split(readable, max(1, readable.size // 1000)):
+        try:
+            UniversalCurves.check_domain_km(hp_km[block], ha_km[block])
+        except InputError:
+            for i in block:
+                try:
+                    UniversalCurves.check_domain_km(hp_km[i], ha_km[i])
+                except InputError as error:
+                    status[i] = f"line {i + 2}: {error}"
+    return rows, hp_km * 1e3, ha_km * 1e3, c, inc, status
 
 
 def batch_lifetimes(

@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.checks import InputError, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import unix_days
@@ -180,17 +181,18 @@ def fit_density_scale(
             outside the curves, or an orbit fit on a time-varying scenario.
     """
     c = satellite.drag_parameter_m2_kg
-    hp = observations.perigee_km * 1e3
-    ha = observations.apogee_km * 1e3
-    UniversalCurves.check_domain(hp, ha)
+    try:
+        hp, ha = UniversalCurves.check_domain_km(observations.perigee_km, observations.apogee_km)
+    except InputError as error:
+        row = error.index[0] if error.index else 0
+        raise ValueError(f"{observations.source}, observation {row + 1}: {error.message(show_index=False)}") from None
     if reentry is not None:
-        t_reentry = unix_days(reentry) if isinstance(reentry, str) else float(reentry)
+        t_reentry = unix_days(reentry) if isinstance(reentry, str) else check_number(reentry, "reentry", unit="days")
         dt_days = t_reentry - float(observations.days[0])
         if not dt_days > 0:
             raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
-        for name, value in (("reentry_sigma_days", reentry_sigma_days), ("height_sigma_km", height_sigma_km)):
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"{name} must be a non-negative number, got {value!r}")
+        check_number(reentry_sigma_days, "reentry_sigma_days", unit="days", low=0.0)
+        check_number(height_sigma_km, "height_sigma_km", unit="km", low=0.0)
         return _fit_reentry(
             float(hp[0]), float(ha[0]), dt_days, c, scenario, inclination_deg, reentry_sigma_days, height_sigma_km
         )

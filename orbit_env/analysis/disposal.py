@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import check_number
 from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M
 
 FloatArray = NDArray[np.float64]
@@ -82,8 +83,7 @@ def check_disposal_rule(
     Raises:
         ValueError: ``rule_years`` not positive.
     """
-    if not (np.isfinite(rule_years) and rule_years > 0.0):
-        raise ValueError(f"the rule must be a positive number of years, got {rule_years!r}")
+    rule_years = check_number(rule_years, "rule_years", unit="years", low=0.0, low_inclusive=False)
     hp = np.atleast_1d(np.asarray(perigee_m, dtype=np.float64))
     ha = np.broadcast_to(np.asarray(apogee_m, dtype=np.float64), hp.shape)
     limit = rule_years * DAYS_PER_YEAR

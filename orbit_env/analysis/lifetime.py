@@ -15,13 +15,14 @@ from numpy.typing import NDArray
 
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.checks import check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
-from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
+from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
 
 FloatArray = NDArray[np.float64]
 Method = Literal["averaged", "curves", "direct"]
@@ -31,13 +32,6 @@ METHODS: tuple[str, ...] = ("averaged", "curves", "direct")
 PAPER_SPHERE_DIAMETER_M = 0.5
 PAPER_SPHERE_MASS_KG = 10.0
 PAPER_DRAG_COEFFICIENT = 2.0
-
-
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -55,16 +49,16 @@ class Satellite:
     area_m2: float = math.pi * (PAPER_SPHERE_DIAMETER_M / 2) ** 2
 
     def __post_init__(self) -> None:
-        _positive("drag coefficient c_x", self.drag_coefficient)
-        _positive("mass (kg)", self.mass_kg)
-        _positive("area (m^2)", self.area_m2)
+        check_number(self.drag_coefficient, "drag_coefficient", low=0.0, low_inclusive=False)
+        check_number(self.mass_kg, "mass_kg", unit="kg", low=0.0, low_inclusive=False)
+        check_number(self.area_m2, "area_m2", unit="m^2", low=0.0, low_inclusive=False)
 
     @classmethod
     def from_mass_per_area(
         cls, mass_per_area_kg_m2: float, drag_coefficient: float = PAPER_DRAG_COEFFICIENT
     ) -> Satellite:
         """A satellite given by its transverse load G/F [kg/m^2] (Eq. 4.1)."""
-        mass_kg = _positive("mass per area (kg/m^2)", mass_per_area_kg_m2)
+        mass_kg = check_number(mass_per_area_kg_m2, "mass_per_area_kg_m2", unit="kg/m^2", low=0.0, low_inclusive=False)
         return cls(drag_coefficient=drag_coefficient, mass_kg=mass_kg, area_m2=1.0)
 
     @property
@@ -174,7 +168,7 @@ def make_satellite(
     if (mass_kg is None) != (area_m2 is None):
         raise ValueError("give --mass and --area together (or --mass-per-area alone)")
     if mass_kg is None or area_m2 is None:
-        return Satellite(drag_coefficient=_positive("drag coefficient c_x", cx))
+        return Satellite(drag_coefficient=cx)
     return Satellite(drag_coefficient=cx, mass_kg=mass_kg, area_m2=area_m2)
 
 
@@ -231,9 +225,9 @@ def lifetime(
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    hp_m, ha_m = (float(x) for x in validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3))
+    hp_m, ha_m = (float(x) for x in validate_heights_km(perigee_km, apogee_km))
     satellite = satellite or Satellite()
-    scale = _positive("density scale", density_scale)
+    scale = check_number(density_scale, "density_scale", low=0.0, low_inclusive=False)
     if activity is not None or epoch is not None:
         if atmosphere is not None or rho100_kg_m3 is not None:
             raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
@@ -253,6 +247,7 @@ def lifetime(
             )
             scale = 1.0
         else:
+            UniversalCurves.check_domain_km(perigee_km, apogee_km)
             return _lifetime_under_activity(
                 hp_m,
                 ha_m,
@@ -304,8 +299,8 @@ def lifetime(
         )
         nu, days = revolutions / per_nu, direct.time_s / SECONDS_PER_DAY
     elif method == "curves":
+        UniversalCurves.check_domain_km(perigee_km, apogee_km)
         curves = universal_curves(model)
-        curves.check_domain(hp_m, ha_m)
         start = curves.locate(hp_m, ha_m)
         tau = np.linspace(float(start.tau), 0.0, 200)
         hp_path, ha_path, mean_period = curves.at(start.label, tau)
@@ -337,20 +332,17 @@ def lifetime(
 def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
     if epoch is None:
         return activity.start_days if isinstance(activity, TableActivity) else 0.0
-    if isinstance(epoch, (int, float)):
-        if not math.isfinite(epoch):
-            raise ValueError(f"epoch must be a date or a finite number of unix days, got {epoch!r}")
-        return float(epoch)
+    if not isinstance(epoch, str):
+        return check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD")
     return unix_days(epoch)
 
 
 def _lifetime_under_activity(
     hp_m: float, ha_m: float, satellite: Satellite, method: str, scale: float, model: SolarDecayModel
 ) -> LifetimeResult:
-    """The time-stepped NRLMSIS lifetime (see :func:`lifetime`)."""
+    """The time-stepped NRLMSIS lifetime (see :func:`lifetime`; the caller checked the heights)."""
     if method == "direct":
         raise ValueError("the direct method needs a fixed atmosphere; with changing solar activity use curves")
-    UniversalCurves.check_domain(hp_m, ha_m)
     c = satellite.drag_parameter_m2_kg
     per_nu = satellite.revolutions_per_nu
     if method == "averaged":
@@ -411,11 +403,12 @@ def check_rule(
     """
     satellite = satellite or Satellite()
     scenario = scenario or Scenario()
-    hp_m, ha_m = validate_heights(float(perigee_km) * 1e3, float(apogee_km) * 1e3)
+    hp_m, ha_m = UniversalCurves.check_domain_km(perigee_km, apogee_km)
     c = satellite.drag_parameter_m2_kg
-    cap_days = (float(rule_years) + 1.0) * 365.25
 
     def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
+        # Called once check_disposal_rule has checked rule_years.
+        cap_days = (float(rule_years) + 1.0) * 365.25
         return scenario.lifetime_days(hp, ha, np.full(hp.shape, c), inclination_deg, max_days=cap_days)
 
     return check_disposal_rule(hp_m, ha_m, rule_years, lifetimes)

@@ -9,13 +9,13 @@ is to be followed), the chunked curves of :mod:`orbit_env.decay.chunked`.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.checks import check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, cached_curves, propagate
@@ -64,8 +64,7 @@ class Scenario:
     def __post_init__(self) -> None:
         if self.atmosphere not in ATMOSPHERES:
             raise ValueError(f"atmosphere must be one of {', '.join(ATMOSPHERES)}, got {self.atmosphere!r}")
-        if not (math.isfinite(self.density_scale) and self.density_scale > 0.0):
-            raise ValueError(f"density scale must be a positive finite number, got {self.density_scale!r}")
+        check_number(self.density_scale, "density_scale", low=0.0, low_inclusive=False)
         if self.atmosphere != "msis" and (self.activity is not None or self.epoch_days is not None):
             raise ValueError("solar activity and epoch apply to the msis atmosphere only (use --atmosphere msis)")
         if self.atmosphere != "paper" and self.rho100_kg_m3 is not None:
