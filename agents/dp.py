@@ -98,28 +98,19 @@ from typing import Any, NamedTuple
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
-from orbit_env.agents.policies import observation_batch
 from scipy.optimize import brentq
 
-from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
     NU_REF,
-    CurvePoint,
     UniversalCurves,
     nu_per_revolution,
     universal_curves,
 )
-from orbit_env.envs.orbit_raising import (
-    DV_SCALE_M_S,
-    HEIGHT_SCALE_M,
-    OrbitRaisingConfig,
-    coast,
-    delta_v_left_m_s,
-    perigee_burn,
-    period_gain_days_per_m_s_per_step,
-)
+from orbit_env.envs import task as task_model
+from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
+from orbit_env.envs.task import BatchState, Task, perigee_burn, period_gain_days_per_m_s_per_step
 
 FloatArray = NDArray[np.float64]
 
@@ -203,81 +194,47 @@ def _interpolation(axes: _Axes, label: FloatArray, life: FloatArray, dv_m_s: Flo
 
 
 class _Step(NamedTuple):
-    """One env step from arrays of states."""
+    """One step of the task from arrays of states."""
 
-    point: CurvePoint  # after the burn and the coast
-    mass_kg: FloatArray
+    state: BatchState  # after the burn and the coast
     life: FloatArray  # steps of life left at the new mass (0 once re-entered)
-    dv_left_m_s: FloatArray
     reward: FloatArray
 
 
 class _Model:
-    """The env's step on arrays of states, for one config and density scale."""
+    """The task with the density known, on arrays of grid states (the task model's functions)."""
 
     def __init__(self, config: OrbitRaisingConfig, density_scale: float) -> None:
         self.config = config
+        self.task = Task(config, DensityConfig(scale_range=(density_scale, density_scale)))
         self.curves: UniversalCurves = universal_curves()
         self.density_scale = density_scale
-        self.drag_area_m2 = config.drag_coefficient * config.area_m2
 
     def step_nu(self, mass_kg: FloatArray) -> FloatArray:
         """The nu one step (K revolutions) is worth at this mass: K g c s (Eq. 4.1)."""
-        nu_per_rev = nu_per_revolution(self.drag_area_m2 / mass_kg, self.density_scale)
-        return self.config.revolutions_per_step * nu_per_rev
+        drag_parameter = self.config.drag_coefficient * self.config.area_m2 / mass_kg
+        return self.config.revolutions_per_step * nu_per_revolution(drag_parameter, self.density_scale)
 
     def mass_kg(self, dv_left_m_s: FloatArray) -> FloatArray:
         """Mass from the delta-v left, by the rocket equation."""
-        return self.config.dry_mass_kg * np.exp(dv_left_m_s / self.config.exhaust_velocity_m_s)
-
-    def point(self, label: FloatArray, tau: FloatArray) -> tuple[CurvePoint, FloatArray, FloatArray]:
-        """The point at (label, tau), with its mean period from ``at`` as the env's, and its heights [m]."""
-        perigee_m, apogee_m, q = self.curves.at(label, tau)
-        return CurvePoint(label, tau, q), perigee_m, apogee_m
-
-    def step(
-        self, point: CurvePoint, perigee_m: FloatArray, apogee_m: FloatArray, mass_kg: FloatArray, requested_dv: float
-    ) -> _Step:
-        """The env's step from ``point`` (with its heights): burn (maybe), then coast."""
         config = self.config
-        dv, apogee_after, mass_after = perigee_burn(
-            perigee_m, apogee_m, mass_kg, config.dry_mass_kg, config.exhaust_velocity_m_s, requested_dv
-        )
-        burned = dv > 0.0
-        if np.any(burned):
-            # As the env's _set_point: the new orbit located, its mean period from table B.
-            moved = self.curves.locate(perigee_m, apogee_after)
-            point = CurvePoint(
-                np.where(burned, moved.label, point.label),
-                np.where(burned, moved.tau, point.tau),
-                np.where(burned, moved.mean_period_s, point.mean_period_s),
-            )
-            mass_after = np.where(burned, mass_after, mass_kg)
-        else:
-            mass_after = np.asarray(mass_kg, dtype=np.float64) + np.zeros_like(point.tau)
-            dv = np.zeros_like(point.tau)
-        after, days = self.coast(point, mass_after, 1.0)
-        life = np.where(after.tau > 0.0, after.nu / self.step_nu(mass_after), 0.0)
-        dv_left = np.maximum(delta_v_left_m_s(mass_after, config.dry_mass_kg, config.exhaust_velocity_m_s), 0.0)
-        return _Step(after, mass_after, life, dv_left, days - config.propellant_cost_per_m_s * dv)
+        return task_model.mass_from_delta_v_left_kg(dv_left_m_s, config.dry_mass_kg, config.exhaust_velocity_m_s)
 
-    def coast(self, point: CurvePoint, mass_kg: FloatArray, steps: Any) -> tuple[CurvePoint, FloatArray]:
-        """The point after coasting ``steps`` steps and the days lived meanwhile (the env's ``coast``)."""
-        nu_per_rev = self.step_nu(mass_kg) / self.config.revolutions_per_step
-        after, _, _, days, _ = coast(
-            self.curves, point, np.multiply(steps, self.config.revolutions_per_step), nu_per_rev
-        )
-        return after, days
+    def states(self, label: FloatArray, life: FloatArray, dv_left_m_s: FloatArray) -> BatchState:
+        """Grid states: on curve ``label`` with ``life`` steps of life left at the mass ``dv_left_m_s`` gives."""
+        tau = np.log1p(life * self.step_nu(self.mass_kg(dv_left_m_s)) / NU_REF)
+        return task_model.states_on_curves(self.task, label, tau, dv_left_m_s, 0.0)
 
-    def coast_days(self, point: CurvePoint, mass_kg: FloatArray, steps: Any) -> FloatArray:
-        """The days of ``steps`` coasts in one: the drop of W over g c s (the sum of the env's coasts' days).
+    def step(self, states: BatchState, requested_dv: float) -> _Step:
+        """The task's step from ``states`` (not changed): burn (maybe), then coast."""
+        after = states.copy()
+        result = task_model.step(self.task, after, requested_dv)
+        life = np.where(after.tau > 0.0, after.nu / (self.config.revolutions_per_step * after.nu_per_rev), 0.0)
+        return _Step(after, life, result.reward)
 
-        ``curves.advance`` alone (the mean period, not the heights): a quarter of
-        the work of :meth:`coast`, for the many states that outlive the mission.
-        """
-        nu_per_rev = self.step_nu(mass_kg) / self.config.revolutions_per_step
-        after = self.curves.advance(point, np.multiply(steps, self.config.revolutions_per_step) * nu_per_rev)
-        return (point.weighted_s - after.weighted_s) / (nu_per_rev * SECONDS_PER_DAY)
+    def coast_days(self, states: BatchState, steps: Any) -> FloatArray:
+        """The days of ``steps`` coasts in one (the sum of the task's coasts' days)."""
+        return task_model.lookahead(self.task, states, 0.0, steps)[0]
 
 
 def _coast_certain_stages(model: _Model) -> int:
@@ -331,10 +288,10 @@ def _labels(model: _Model, n_label: int) -> FloatArray:
     if n_label < 6 or not burns or config.delta_v_capacity_m_s <= 0.0:
         return np.linspace(MU_LOW, top, n_label)
     mu = np.arange(MU_LOW, top, 0.002)
-    mass = np.full(mu.size, config.wet_mass_kg)
-    life = LABEL_REFERENCE_LIFE * config.horizon_steps
-    point, perigee_m, apogee_m = model.point(mu, np.log1p(life * model.step_nu(mass) / NU_REF))
-    moved = model.step(point, perigee_m, apogee_m, mass, min(burns)).point.label - mu
+    life = np.full(mu.size, LABEL_REFERENCE_LIFE * config.horizon_steps)
+    states = model.states(mu, life, config.delta_v_capacity_m_s)
+    apogee_m = states.apogee_m
+    moved = model.step(states, min(burns)).state.label - mu
     fine = (apogee_m <= LABEL_FINE_APOGEE * CURVES_MAX_APOGEE_M) & (moved > 0.0)
     end = int(np.argmin(fine)) if not fine.all() else mu.size
     if end < 2:
@@ -377,14 +334,11 @@ def _axes(model: _Model, grid: tuple[int, int, int]) -> _Axes:
     return _Axes(label, np.concatenate([unit, tail]), dv_m_s, unit.size, life_per_step)
 
 
-def _grid_states(model: _Model, axes: _Axes, rows: NDArray[np.intp]) -> tuple[CurvePoint, FloatArray, FloatArray, Any]:
-    """Point, heights and mass of flat grid states."""
+def _grid_states(model: _Model, axes: _Axes, rows: NDArray[np.intp]) -> BatchState:
+    """The task's states at flat grid indices."""
     j, rest = np.divmod(rows, axes.plane)
     i, k = np.divmod(rest, axes.dv_m_s.size)
-    mass = model.mass_kg(axes.dv_m_s[k])
-    tau = np.log1p(axes.life[j] * model.step_nu(mass) / NU_REF)
-    point, perigee_m, apogee_m = model.point(axes.label[i], tau)
-    return point, perigee_m, apogee_m, mass
+    return model.states(axes.label[i], axes.life[j], axes.dv_m_s[k])
 
 
 @dataclass
@@ -409,7 +363,7 @@ class DPSolution:
     _rows: NDArray[np.int64]  # decision states of stage k (a prefix of the state vector)
     _cumulative: FloatArray  # sums of the coasts' days along the life levels [days]
     _coast_certain: int  # stages up to which the satellites that outlive them coast
-    _tail: tuple[CurvePoint, FloatArray]  # the states of the life axis' tail and their masses
+    _tail: BatchState  # the states of the life axis' tail
 
     @property
     def num_states(self) -> int:
@@ -430,12 +384,9 @@ class DPSolution:
         shift = stage * axes.life_per_step * axes.plane
         out[unit] = self._cumulative[rows[unit]] - self._cumulative[rows[unit] - shift]
         tail = np.flatnonzero(~unit)
-        point, mass = self._tail
         for start in range(0, tail.size, CHUNK_STATES):
             chunk = tail[start : start + CHUNK_STATES]
-            at = rows[chunk] - unit_rows
-            part = CurvePoint(point.label[at], point.tau[at], point.mean_period_s[at])
-            out[chunk] = self._model.coast_days(part, mass[at], stage)
+            out[chunk] = self._model.coast_days(self._tail.take(rows[chunk] - unit_rows), stage)
         return out
 
     def stage_values(self, stage: int, rows: Any = None) -> FloatArray:
@@ -450,37 +401,24 @@ class DPSolution:
             out[~stored] = self._coast_days(stage, rows[~stored])
         return out
 
-    def _state(
-        self, perigee_m: FloatArray, apogee_m: FloatArray, dv_left_m_s: FloatArray
-    ) -> tuple[CurvePoint, FloatArray, FloatArray, FloatArray]:
-        """The env's point, heights and mass for observed heights and delta-v left."""
-        model = self._model
-        located = model.curves.locate(perigee_m, apogee_m)
-        point, perigee, apogee = model.point(located.label, located.tau)
-        return point, perigee, apogee, model.mass_kg(dv_left_m_s)
-
-    def q_values(
-        self, perigee_m: FloatArray, apogee_m: FloatArray, dv_left_m_s: FloatArray, steps_left: NDArray[np.intp]
-    ) -> FloatArray:
+    def q_values(self, states: BatchState, steps_left: NDArray[np.intp]) -> FloatArray:
         """r_a + V_{k-1}(successor_a) for each state (rows) and action (columns) [days]; 0 at k = 0."""
-        point, perigee, apogee, mass = self._state(perigee_m, apogee_m, dv_left_m_s)
         stage = np.clip(steps_left - 1, 0, self.config.horizon_steps - 1)
-        q = np.empty((np.size(point.tau), len(self.config.burn_sizes_m_s)))
+        q = np.empty((states.size, len(self.config.burn_sizes_m_s)))
         for a, burn in enumerate(self.config.burn_sizes_m_s):
-            step = self._model.step(point, perigee, apogee, mass, burn)
+            step = self._model.step(states, burn)
             future = np.zeros(q.shape[0])
             # A successor that outlives the mission coasts: its days are summed exactly.
             exact = (stage <= self._coast_certain) & (step.life >= stage)
             if exact.any():
-                after = CurvePoint(step.point.label[exact], step.point.tau[exact], step.point.mean_period_s[exact])
-                future[exact] = self._model.coast_days(after, step.mass_kg[exact], stage[exact])
-            index, weight = _interpolation(self._axes, step.point.label, step.life, step.dv_left_m_s)
+                future[exact] = self._model.coast_days(step.state.take(exact), stage[exact])
+            index, weight = _interpolation(self._axes, step.state.label, step.life, step.state.dv_left_m_s)
             for s in np.unique(stage[~exact]):
                 mine = ~exact & (stage == s)
                 future[mine] = (self.stage_values(int(s), index[mine]) * weight[mine]).sum(axis=1)
             q[:, a] = step.reward + future
         # A re-entered satellite or an ended mission earns nothing more.
-        q[(steps_left <= 0) | (point.tau <= 0.0)] = 0.0
+        q[(steps_left <= 0) | (states.tau <= 0.0)] = 0.0
         return q
 
     def value(self, perigee_km: Any, apogee_km: Any, dv_left_m_s: Any, steps_left: Any) -> FloatArray:
@@ -506,8 +444,9 @@ class DPSolution:
         if not (np.all(k == np.round(k)) and np.all((k >= 0) & (k <= horizon))):
             raise ValueError(f"steps_left={steps_left!r} is invalid; allowed: integers 0 to {horizon}")
         shape = hp.shape
-        q = self.q_values(hp.ravel(), ha.ravel(), dv.ravel(), k.ravel().astype(np.intp))
-        return q.max(axis=1).reshape(shape)
+        k = k.ravel().astype(np.intp)
+        states = task_model.states_at_orbits(self._model.task, hp.ravel(), ha.ravel(), dv.ravel(), horizon - k)
+        return self.q_values(states, k).max(axis=1).reshape(shape)
 
 
 def _check_grid(grid: Any) -> tuple[int, int, int]:
@@ -573,15 +512,15 @@ def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArra
     down = axes.life_per_step * axes.plane
     for start in range(0, n, CHUNK_STATES):
         rows = np.arange(start, min(start + CHUNK_STATES, n))
-        point, perigee_m, apogee_m, mass = _grid_states(model, axes, rows)
-        alive = point.tau > 0.0
+        states = _grid_states(model, axes, rows)
+        alive = states.tau > 0.0
         for a, burn in enumerate(actions):
             coasting = has_coast and a == 0
             if not coasting and start >= decision_rows:
                 parts[a].append((np.zeros(rows.size, np.int64), np.zeros(0, np.int32), np.zeros(0, np.float32)))
                 continue
-            step = model.step(point, perigee_m, apogee_m, mass, burn)
-            index, weight = _interpolation(axes, step.point.label, step.life, step.dv_left_m_s)
+            step = model.step(states, burn)
+            index, weight = _interpolation(axes, step.state.label, step.life, step.state.dv_left_m_s)
             keep = (weight > 0.0) & alive[:, None]
             rewards[a, rows] = np.where(alive, step.reward, 0.0)
             if coasting:
@@ -639,7 +578,7 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
     # far below the grid's own error.
     values = np.zeros(int(rows.sum()), dtype=np.uint16)
     top = np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS
-    tail_point, _, _, tail_mass = _grid_states(model, axes, np.arange(unit_rows, n))
+    tail = _grid_states(model, axes, np.arange(unit_rows, n))
     solution = DPSolution(
         config,
         density_scale,
@@ -652,7 +591,7 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
         rows,
         cumulative,
         certain,
-        (tail_point, tail_mass),
+        tail,
     )
     # The tail's states that a burn from a deciding state lands next to (the others are never read).
     referenced = max((int(m.indices.max(initial=0)) for m in [*matrices, tail_coast] if m is not None), default=0)
@@ -730,11 +669,7 @@ class DPPolicy:
         deterministic: bool = True,
     ) -> tuple[Any, Any]:
         """Actions for one observation (7,) or a batch (n, 7); SB3's signature."""
-        batch = observation_batch(observation)
-        perigee = np.clip(batch[:, 0] * HEIGHT_SCALE_M, REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M)
-        apogee = np.clip(batch[:, 1] * HEIGHT_SCALE_M, perigee, CURVES_MAX_APOGEE_M)
-        dv_left = np.maximum(batch[:, 2] * DV_SCALE_M_S, 0.0)
-        horizon = self.config.horizon_steps
-        steps_left = horizon - np.rint(np.clip(batch[:, 3], 0.0, 1.0) * horizon).astype(np.intp)
-        actions = np.argmax(self.solution.q_values(perigee, apogee, dv_left, steps_left), axis=1).astype(np.int64)
+        states = task_model.decode(self.solution._model.task, observation)
+        steps_left = (self.config.horizon_steps - states.steps).astype(np.intp)
+        actions = np.argmax(self.solution.q_values(states, steps_left), axis=1).astype(np.int64)
         return (actions[0] if np.ndim(observation) == 1 else actions), state

@@ -15,9 +15,9 @@ from typing import Any, Protocol
 import gymnasium
 import numpy as np
 from numpy.typing import NDArray
-from orbit_env.agents.policies import HAND_CODED
 
 import orbit_env  # noqa: F401  (registers the environments)
+from orbit_env.agents.policies import HAND_CODED
 from orbit_env.envs import ENV_IDS
 
 FloatArray = NDArray[np.float64]

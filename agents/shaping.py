@@ -12,8 +12,8 @@ would still live within the mission if it coasted from s to the end,
 
     Phi(s) = (W(s) - W(s advanced by steps_left x K revolutions)) / (g c s x 1 day),
 
-with W = Int P dnu of the universal curves (:func:`orbit_env.envs.orbit_raising.coast`
-over the rest of the mission, clamped at re-entry). Phi is 0 at re-entry (W = 0)
+with W = Int P dnu of the universal curves (:func:`orbit_env.envs.task.lookahead`
+without a burn, over the rest of the mission, clamped at re-entry). Phi is 0 at re-entry (W = 0)
 and at the horizon (no steps left). A coasting step's shaped reward is then 0 up to
 rounding (the coast moves nu by the same amount the potential's coast does), and
 a burn's is at once its gain in days within the mission minus the propellant's
@@ -51,9 +51,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
 
-from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
-from orbit_env.envs.orbit_raising import Coast, OrbitRaisingConfig, coast, period_gain_days_per_m_s_per_step
+from orbit_env.envs import task as task_model
+from orbit_env.envs.config import OrbitRaisingConfig
+from orbit_env.envs.task import AnyState, Task, period_gain_days_per_m_s_per_step
 
 FloatArray = NDArray[np.float64]
 
@@ -61,61 +63,24 @@ FloatArray = NDArray[np.float64]
 SHAPINGS = ("none", "never_burn_value")
 
 
-def coast_to_mission_end(
-    config: OrbitRaisingConfig,
-    label: FloatArray,
-    tau: FloatArray,
-    mass_kg: FloatArray,
-    density_scale: FloatArray,
-    steps_left: FloatArray,
-) -> Coast:
-    """Coast each satellite, never burning again, to the end of the mission (or re-entry).
+def outlook(task: Task, state: AnyState) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """Phi and "decided" of every satellite of a state of the task model.
 
-    Args:
-        config: The environment's config (drag coefficient, area, revolutions per step).
-        label: Curve label mu of each satellite (the env's ``state["label"]``).
-        tau: Position tau on the curve (``state["tau"]``).
-        mass_kg: Current mass [kg].
-        density_scale: Current density scale, held for the rest of the mission.
-        steps_left: Steps left in the mission (0 at the horizon).
-
-    Returns:
-        The coast: ``days`` lived within the mission, ``point.tau`` > 0 where the
-        satellite is still in orbit at the mission's end.
-    """
-    curves = universal_curves()
-    label = np.asarray(label, dtype=np.float64)
-    tau = np.asarray(tau, dtype=np.float64)
-    _, _, period_s = curves.at(label, tau)
-    point = CurvePoint(label=label, tau=tau, mean_period_s=period_s)
-    drag_parameter = config.drag_coefficient * config.area_m2 / np.asarray(mass_kg, dtype=np.float64)
-    nu_per_rev = nu_per_revolution(drag_parameter, np.asarray(density_scale, dtype=np.float64))
-    revolutions = np.maximum(np.asarray(steps_left, dtype=np.float64), 0.0) * config.revolutions_per_step
-    return coast(curves, point, revolutions, nu_per_rev)
-
-
-def outlook(env: Any, observations: NDArray[np.float32]) -> tuple[FloatArray, NDArray[np.bool_]]:
-    """Phi and "decided" of every satellite of an orbit-raising vector env, from its public state.
-
+    Phi: the days never burning again still earns within the mission, at the
+    density of now (:func:`orbit_env.envs.task.lookahead` without a burn).
     Decided: the tank is empty, or the satellite outlives the mission without
-    another burn (see the module). The steps taken come from the observation's
-    mission clock (steps / horizon, exact in float32 for any horizon below 2^24 steps).
+    another burn (see the module).
     """
-    config = env.config
-    state = env.state
-    obs = np.asarray(observations, dtype=np.float64)
-    steps_left = config.horizon_steps - np.rint(obs[:, 3] * config.horizon_steps)
-    end = coast_to_mission_end(
-        config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], steps_left
-    )
-    decided = (end.point.tau > 0.0) | (obs[:, 2] <= 0.0)
-    return np.maximum(end.days, 0.0), decided
+    steps_left = task.config.horizon_steps - state.steps
+    phi, _ = task_model.lookahead(task, state, 0.0, steps_left)
+    decided = task_model.outlives(task, state, steps_left) | (state.dv_left_m_s <= 0.0)
+    return np.maximum(phi, 0.0), decided
 
 
 def period_gain_days_per_m_s(config: OrbitRaisingConfig) -> float:
     """The most mission days a perigee burn can add per m/s by lengthening the period alone.
 
-    :func:`orbit_env.envs.orbit_raising.period_gain_days_per_m_s_per_step` for each
+    :func:`orbit_env.envs.task.period_gain_days_per_m_s_per_step` for each
     of the mission's steps.
     """
     return period_gain_days_per_m_s_per_step(config.revolutions_per_step) * config.horizon_steps
@@ -126,8 +91,11 @@ def burns_cannot_pay_once_the_mission_is_covered(config: OrbitRaisingConfig) -> 
     return period_gain_days_per_m_s(config) < config.propellant_cost_per_m_s
 
 
-def never_burn_value_shaping(venv: Any, end_decided: float = 0.0, seed: int | None = None) -> Any:
-    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with :class:`NeverBurnValueShaping`.
+class NeverBurnValueShaping(VecEnvWrapper):
+    """Reward r + Phi(s') - Phi(s), Phi(s') = 0 where the episode ended (see the module).
+
+    ``infos[i]["unshaped_reward"]`` keeps the environment's reward;
+    ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
 
     Args:
         venv: The SB3 view of an orbit-raising vector env (:mod:`orbit_env.envs.sb3`).
@@ -139,60 +107,63 @@ def never_burn_value_shaping(venv: Any, end_decided: float = 0.0, seed: int | No
         ValueError: ``end_decided`` outside [0, 1], or > 0 where it would not be
             exact: a drifting or unknown density, or burns that can pay by the period.
     """
-    from stable_baselines3.common.vec_env import VecEnvWrapper
 
-    env = venv.unwrapped.env  # the Gymnasium vector env under SB3VecEnv
-    if not 0.0 <= end_decided <= 1.0:
-        raise ValueError(f"end_decided={end_decided!r} is invalid; allowed: a probability in [0, 1]")
-    if end_decided > 0.0:
-        low, high = env.density.scale_range
-        if env.density.varies or low != high:
-            raise ValueError("end_decided needs a known, constant density: with another the mission is never covered")
-        if not burns_cannot_pay_once_the_mission_is_covered(env.config):
-            raise ValueError(
-                f"end_decided is not exact for this config: a burn may add {period_gain_days_per_m_s(env.config):.3f} "
-                f"mission days per m/s by the period, more than its cost {env.config.propellant_cost_per_m_s}"
-            )
+    def __init__(self, venv: VecEnv, end_decided: float = 0.0, seed: int | None = None) -> None:
+        env = venv.unwrapped.env  # the Gymnasium vector env under SB3VecEnv
+        if not 0.0 <= end_decided <= 1.0:
+            raise ValueError(f"end_decided={end_decided!r} is invalid; allowed: a probability in [0, 1]")
+        if end_decided > 0.0:
+            low, high = env.density.scale_range
+            if env.density.varies or low != high:
+                raise ValueError(
+                    "end_decided needs a known, constant density: with another the mission is never covered"
+                )
+            if not burns_cannot_pay_once_the_mission_is_covered(env.config):
+                raise ValueError(
+                    f"end_decided is not exact for this config: a burn may add "
+                    f"{period_gain_days_per_m_s(env.config):.3f} mission days per m/s by the period, "
+                    f"more than its cost {env.config.propellant_cost_per_m_s}"
+                )
+        super().__init__(venv)
+        self.env = env
+        self.end_decided = float(end_decided)
+        self.phi = np.zeros(self.num_envs)
+        self.decided = np.zeros(self.num_envs, dtype=bool)
+        self.rng = np.random.default_rng(seed)
 
-    class NeverBurnValueShaping(VecEnvWrapper):
-        """Reward r + Phi(s') - Phi(s), Phi(s') = 0 where the episode ended (see the module).
+    def _outlook(self) -> tuple[FloatArray, NDArray[np.bool_]]:
+        return outlook(self.env.task, self.env.task_state)
 
-        ``infos[i]["unshaped_reward"]`` keeps the environment's reward;
-        ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
-        """
+    def reset(self) -> Any:
+        """Reset the environments and take the potential of the start states."""
+        obs = self.venv.reset()
+        self.phi, self.decided = self._outlook()
+        return obs
 
-        def __init__(self, inner: Any) -> None:
-            super().__init__(inner)
-            self.env = env
-            self.phi = np.zeros(self.num_envs)
-            self.decided = np.zeros(self.num_envs, dtype=bool)
-            self.rng = np.random.default_rng(seed)
+    def step_wait(self) -> Any:
+        """Step, shape the rewards, and end decided episodes with probability ``end_decided``."""
+        obs, rewards, dones, infos = self.venv.step_wait()
+        # Finished satellites have restarted: obs and state are the new episode's s_0.
+        phi_next, decided_next = self._outlook()
+        shaped = rewards + np.where(dones, 0.0, phi_next) - self.phi
+        for info, reward in zip(infos, rewards, strict=True):
+            info["unshaped_reward"] = float(reward)
+        if self.end_decided > 0.0:
+            end = self.decided & ~dones & (self.rng.random(self.num_envs) < self.end_decided)
+            if end.any():
+                # shaped already holds r + Phi(s') - Phi(s) there: the optimal continuation's value.
+                dones = dones | end
+                for i in np.flatnonzero(end):
+                    infos[i]["terminal_observation"] = obs[i].copy()
+                    infos[i]["decided_end"] = True
+                obs, _ = self.env.reset(options={"reset_mask": end})
+                phi_new, decided_new = self._outlook()
+                phi_next = np.where(end, phi_new, phi_next)
+                decided_next = np.where(end, decided_new, decided_next)
+        self.phi, self.decided = phi_next, decided_next
+        return obs, shaped.astype(np.float32), dones, infos
 
-        def reset(self) -> Any:
-            obs = self.venv.reset()
-            self.phi, self.decided = outlook(self.env, obs)
-            return obs
 
-        def step_wait(self) -> Any:
-            obs, rewards, dones, infos = self.venv.step_wait()
-            # Finished satellites have restarted: obs and state are the new episode's s_0.
-            phi_next, decided_next = outlook(self.env, obs)
-            shaped = rewards + np.where(dones, 0.0, phi_next) - self.phi
-            for info, reward in zip(infos, rewards, strict=True):
-                info["unshaped_reward"] = float(reward)
-            if end_decided > 0.0:
-                end = self.decided & ~dones & (self.rng.random(self.num_envs) < end_decided)
-                if end.any():
-                    # shaped already holds r + Phi(s') - Phi(s) there: the optimal continuation's value.
-                    dones = dones | end
-                    for i in np.flatnonzero(end):
-                        infos[i]["terminal_observation"] = obs[i].copy()
-                        infos[i]["decided_end"] = True
-                    obs, _ = self.env.reset(options={"reset_mask": end})
-                    phi_new, decided_new = outlook(self.env, obs)
-                    phi_next = np.where(end, phi_new, phi_next)
-                    decided_next = np.where(end, decided_new, decided_next)
-            self.phi, self.decided = phi_next, decided_next
-            return obs, shaped.astype(np.float32), dones, infos
-
-    return NeverBurnValueShaping(venv)
+def never_burn_value_shaping(venv: Any, end_decided: float = 0.0, seed: int | None = None) -> NeverBurnValueShaping:
+    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with :class:`NeverBurnValueShaping`."""
+    return NeverBurnValueShaping(venv, end_decided=end_decided, seed=seed)

@@ -5,6 +5,8 @@ import json
 import gymnasium
 import numpy as np
 import pytest
+
+import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import (
     EVAL_SEED,
     Episodes,
@@ -14,10 +16,9 @@ from orbit_env.agents.evaluate import (
     summarize,
 )
 from orbit_env.agents.policies import AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
-
-import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.cli import main
-from orbit_env.envs.orbit_raising import OrbitRaisingConfig
+from orbit_env.envs import task as task_model
+from orbit_env.envs.config import OrbitRaisingConfig
 
 
 @pytest.fixture(scope="module")
@@ -86,7 +87,7 @@ def test_policies_answer_sb3_predict_single_and_batched(cls):
 def test_apogee_threshold_burns_only_below_threshold():
     policy = ApogeeThreshold(threshold_km=700, target_km=1000)
     obs = np.array([[0.36, 0.65, 0.3, 0, 0.5, 0, 0], [0.36, 0.9, 0.3, 0, 0.5, 0, 0]], dtype=np.float32)
-    burns = policy.burns_m_s(obs)
+    burns = policy.burns_m_s(task_model.decode(policy.task, obs))
     # 360 x 650 -> 360 x 1000 km needs about 90 m/s: the 100 m/s size; above 700 km nothing.
     assert burns[0] == 100.0 and burns[1] == 0.0
 

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import gymnasium as gym
 import numpy as np
-import orbit_env.agents.dp as dp
 import pytest
-from orbit_env.agents.dp import DPPolicy, solve
 
 import orbit_env  # noqa: F401  (registers the environments)
-from orbit_env.envs.orbit_raising import OrbitRaisingConfig
+import orbit_env.agents.dp as dp
+from orbit_env.agents.dp import DPPolicy, solve
+from orbit_env.envs import task as task_model
+from orbit_env.envs.config import OrbitRaisingConfig
 
 CONFIG = OrbitRaisingConfig(
     horizon_steps=60, start_perigee_km=(160.0, 260.0), start_apogee_max_km=900.0, propellant_cost_per_m_s=0.05
@@ -137,8 +138,8 @@ def test_a_satellite_that_outlives_the_mission_is_worth_its_coasting_days():
     never, starts = run_vector(LONG, lambda obs: np.zeros(len(obs), dtype=np.int64))
     solution = solve(LONG, grid=(8, 1, 1))
     full, steps = LONG.delta_v_capacity_m_s, LONG.horizon_steps
-    point, _, _, mass = solution._state(starts[:, 0] * 1e3, starts[:, 1] * 1e3, np.full(len(never), full))
-    outlive = point.nu / solution._model.step_nu(mass) >= steps
+    states = task_model.states_at_orbits(solution._model.task, starts[:, 0] * 1e3, starts[:, 1] * 1e3, full, 0.0)
+    outlive = task_model.outlives(solution._model.task, states, steps)
     assert outlive.sum() >= 5
     value = solution.value(starts[:, 0], starts[:, 1], full, steps)
     # Equal up to locating the env's heights again (its heights are read back from its

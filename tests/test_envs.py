@@ -39,7 +39,8 @@ from orbit_env.decay.averaged import integrate_averaged
 from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig, OrbitRaisingEnv, register_envs
 from orbit_env.envs import orbit_raising as orbit_raising_module
-from orbit_env.envs.orbit_raising import DEFAULT_HORIZON_STEPS, OBS_HIGH, delta_v_left_m_s
+from orbit_env.envs.config import DEFAULT_HORIZON_STEPS
+from orbit_env.envs.task import OBS_HIGH, delta_v_left_m_s
 from orbit_env.envs.vector import OrbitRaisingVectorEnv
 from orbit_env.physics.orbit import perigee_velocity_m_s
 
@@ -465,7 +466,7 @@ def check_invariants(obs, state, reward, space):
 def test_random_configs_and_actions_keep_the_state_physical(config, density, continuous, seed, data):
     env = OrbitRaisingEnv(config, continuous=continuous, density=density)
     obs, _ = env.reset(seed=seed)
-    dry = env._ep.dry_mass_kg
+    dry = env.task_state.dry_mass_kg
     check_invariants(obs, env.state, 0.0, env.observation_space)
     if continuous:
         actions = data.draw(st.lists(st.floats(-1.0, 1.0, width=32), max_size=config.horizon_steps))
@@ -490,7 +491,7 @@ def test_random_configs_keep_the_vector_state_physical(config, density, continuo
     for _ in range(config.horizon_steps + 2):  # past the horizon: the restarts too
         obs, reward, *_ = env.step(env.action_space.sample())
         check_invariants(obs, env.state, reward, env.observation_space)
-        assert np.all(env.state["mass_kg"] >= env._dry_mass_kg)
+        assert np.all(env.state["mass_kg"] >= env.task_state.dry_mass_kg)
 
 
 @pytest.mark.parametrize(
@@ -529,10 +530,19 @@ def test_invalid_vector_actions_raise_value_errors():
     ("options", "message"),
     [
         ({"altitude_km": 300.0}, r"unknown reset option\(s\) \['altitude_km'\]"),
-        ({"perigee_km": 50.0, "apogee_km": 400.0}, r"perigee height 50 km is below the re-entry height"),
-        ({"perigee_km": 400.0, "apogee_km": 300.0}, r"apogee height 300 km is below the perigee height 400 km"),
-        ({"perigee_km": 300.0, "apogee_km": 4500.0}, r"apogee height 4500 km is outside the universal curves"),
-        ({"perigee_km": 1200.0, "apogee_km": 1500.0}, r"perigee height 1200 km is outside the universal curves"),
+        ({"perigee_km": 50.0, "apogee_km": 400.0}, r"perigee_km(\[0\])?=50 is out of range; allowed: 100 to 1100 km"),
+        (
+            {"perigee_km": 400.0, "apogee_km": 300.0},
+            r"apogee_km(\[0\])?=300 is out of range; allowed: perigee_km(\[0\])? \(400\) to 4000 km",
+        ),
+        (
+            {"perigee_km": 300.0, "apogee_km": 4500.0},
+            r"apogee_km(\[0\])?=4500 is out of range; allowed: perigee_km(\[0\])? \(300\) to 4000 km",
+        ),
+        (
+            {"perigee_km": 1200.0, "apogee_km": 1500.0},
+            r"perigee_km(\[0\])?=1200 is out of range; allowed: 100 to 1100 km",
+        ),
         ({"perigee_km": float("nan")}, r"reset option perigee_km=nan must be finite"),
         ({"propellant_mass_kg": -1.0}, r"propellant_mass_kg=-1.0 is invalid; allowed: a finite number >= 0"),
         ({"dry_mass_kg": 0.0}, r"dry_mass_kg=0.0 is invalid"),

@@ -3,21 +3,18 @@
 import gymnasium
 import numpy as np
 import pytest
-from orbit_env.agents.shaping import coast_to_mission_end, never_burn_value_shaping, period_gain_days_per_m_s
-from orbit_env.agents.train import load_config
 
 import orbit_env  # noqa: F401  (registers the environments)
-from orbit_env.envs.orbit_raising import OrbitRaisingConfig
+from orbit_env.agents.shaping import never_burn_value_shaping, period_gain_days_per_m_s
+from orbit_env.agents.train import load_config
+from orbit_env.envs import task as task_model
+from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.sb3 import make_sb3_vec_env
 
 
 def _phi_of(env: gymnasium.Env, steps_left: float) -> float:
-    state = env.unwrapped.state
-    config = env.unwrapped.config
-    end = coast_to_mission_end(
-        config, state["label"], state["tau"], state["mass_kg"], state["density_scale"], steps_left
-    )
-    return float(end.days)
+    """The potential of the single env's state: the shaping's look-ahead without a burn."""
+    return float(task_model.lookahead(env.unwrapped.task, env.unwrapped.task_state, 0.0, steps_left)[0])
 
 
 def test_shaped_returns_telescope_to_the_true_return_minus_phi_at_the_start():

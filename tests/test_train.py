@@ -5,23 +5,23 @@ import math
 import numpy as np
 import pytest
 import torch
+
 from orbit_env.agents.features import LogFeatures
 from orbit_env.agents.train import linear_decay, load_config
-
-from orbit_env.envs.orbit_raising import LIFETIME_SCALE_DAYS, observation, observation_space
+from orbit_env.envs.task import LIFETIME_SCALE_DAYS, Task, observation
 
 
 def test_log_features_append_log_lifetime_and_log_time_left():
     # A satellite predicted to live 10 days, 100 steps into a 365-step mission.
     obs = np.array(observation(300e3, 500e3, 250.0, 100 / 365, 10.0, 2e3, 0.2e3), dtype=np.float32)[None, :]
-    features = LogFeatures(observation_space())(torch.as_tensor(obs)).numpy()
+    features = LogFeatures(Task().observation_space)(torch.as_tensor(obs)).numpy()
     assert features.shape == (1, 9)
     np.testing.assert_array_equal(features[:, :7], obs)  # the observation passes unchanged
     assert features[0, 7] == pytest.approx(math.log(10.0 / LIFETIME_SCALE_DAYS), abs=1e-4)
     assert features[0, 8] == pytest.approx(math.log(1 - 100 / 365), abs=1e-5)
     # The ends of the observation space give finite features.
-    ends = torch.as_tensor(np.stack([observation_space().low, observation_space().high]))
-    assert torch.isfinite(LogFeatures(observation_space())(ends)).all()
+    ends = torch.as_tensor(np.stack([Task().observation_space.low, Task().observation_space.high]))
+    assert torch.isfinite(LogFeatures(Task().observation_space)(ends)).all()
 
 
 def test_linear_decay_holds_the_rate_then_falls_to_zero():

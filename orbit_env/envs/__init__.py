@@ -16,13 +16,8 @@ from __future__ import annotations
 
 import gymnasium
 
-from orbit_env.envs.orbit_raising import (
-    DEFAULT_HORIZON_STEPS,
-    UNCERTAIN_DENSITY,
-    DensityConfig,
-    OrbitRaisingConfig,
-    OrbitRaisingEnv,
-)
+from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
+from orbit_env.envs.orbit_raising import OrbitRaisingEnv
 
 __all__ = ["ENV_IDS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv", "register_envs"]
 

@@ -1,0 +1,254 @@
+"""Parameters of the orbit-raising task: the satellite, the mission and the density knowledge.
+
+Frozen dataclasses checked at construction (``ValueError`` naming the field and the
+allowed range); derived quantities (wet mass, exhaust velocity, delta-v capacity)
+are properties. SI units except where a name says otherwise (``_km``, ``_days``,
+``_s`` for the specific impulse in seconds). The decision problem built on them is
+:mod:`orbit_env.envs.task`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
+
+#: Largest delta-v a satellite may carry [m/s]. More is beyond escape from low orbit,
+#: never an orbit-raising budget; the bound keeps the observation space bounded.
+MAX_DV_CAPACITY_M_S = 3000.0
+#: Default mission length in steps; also the registered ``max_episode_steps``.
+DEFAULT_HORIZON_STEPS = 365
+
+
+def _check(name: str, value: Any, ok: bool, allowed: str) -> None:
+    if not ok:
+        raise ValueError(f"{name}={value!r} is invalid; allowed: {allowed}")
+
+
+def _finite_positive(name: str, value: Any) -> None:
+    _check(name, value, isinstance(value, (int, float)) and math.isfinite(value) and value > 0, "a finite number > 0")
+
+
+@dataclass(frozen=True)
+class DensityConfig:
+    """How well the environment's agent knows the upper-air density.
+
+    The paper's Table 1 atmosphere times a scale s. The paper notes (section 1)
+    that published upper-air densities differed by 1.5-2.5 orders of magnitude,
+    and that the lifetime is about inversely proportional to the density near
+    the perigee (section 4). Per episode, s0 is drawn log-uniform in
+    ``scale_range``; during the episode s(t) = s0 exp(A sin(2 pi t / T + phi)),
+    a solar-cycle-like factor with random phase phi, held constant over each step.
+
+    Args:
+        scale_range: (low, high) of the log-uniform s0. Equal ends: a known density.
+        cycle_amplitude: A, the natural-log amplitude of the slow modulation (0: none).
+        cycle_period_days: T, the modulation period [days] (default: the 11-year
+            solar cycle).
+    """
+
+    scale_range: tuple[float, float] = (1.0, 1.0)
+    cycle_amplitude: float = 0.0
+    cycle_period_days: float = 4018.0
+
+    def __post_init__(self) -> None:
+        low_high = tuple(self.scale_range) if isinstance(self.scale_range, (tuple, list)) else ()
+        _check(
+            "scale_range",
+            self.scale_range,
+            len(low_high) == 2
+            and all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in low_high)
+            and low_high[0] <= low_high[1],
+            "(low, high) with 0 < low <= high",
+        )
+        object.__setattr__(self, "scale_range", (float(low_high[0]), float(low_high[1])))
+        _check(
+            "cycle_amplitude",
+            self.cycle_amplitude,
+            isinstance(self.cycle_amplitude, (int, float)) and 0.0 <= self.cycle_amplitude <= 5.0,
+            "0 to 5 (natural-log amplitude)",
+        )
+        _finite_positive("cycle_period_days", self.cycle_period_days)
+
+    @property
+    def nominal_scale(self) -> float:
+        """Geometric mean of ``scale_range``: the scale a ground station would assume."""
+        return math.sqrt(self.scale_range[0] * self.scale_range[1])
+
+    @property
+    def varies(self) -> bool:
+        """Whether the density changes during an episode."""
+        return self.cycle_amplitude > 0.0
+
+
+#: The density of ``OrbitRaisingUncertain-v0``: s0 log-uniform over the two orders
+#: of magnitude of the paper's section 1 (0.1 to 10 times its atmosphere), and a
+#: solar-cycle factor of e^{+-0.5}: over a one-year mission it drifts by up to 30%.
+UNCERTAIN_DENSITY = DensityConfig(scale_range=(0.1, 10.0), cycle_amplitude=0.5)
+
+
+@dataclass(frozen=True)
+class OrbitRaisingConfig:
+    """Satellite, task and start distribution of the orbit-raising environments.
+
+    All defaults are chosen together so that the decision depends on the state
+    (see :class:`OrbitRaisingEnv`, "Why these defaults").
+
+    Args:
+        drag_coefficient: c_x, the drag coefficient (2.2, the usual value for a
+            compact satellite in free-molecular flow; the paper's example uses 2).
+        area_m2: F, the cross-section [m^2] (1 m^2: a small body with solar wings;
+            with the masses below G/F = 46 kg/m^2, near the 51 kg/m^2 of the
+            paper's example sphere).
+        dry_mass_kg: Mass without propellant [kg] (40 kg).
+        propellant_mass_kg: Propellant at the start [kg] (6 kg: with the Isp below
+            300 m/s, enough to take a 250 km circular orbit to 250 x 1380 km).
+        isp_s: Specific impulse [s] (220 s, a hydrazine monopropellant thruster).
+        burn_sizes_m_s: Delta-v of each discrete action [m/s] (0, 10, 30, 100):
+            coast, a trim (about +35 km of apogee), a medium burn (+100 km) and
+            one of the class of the paper's 78 m/s manoeuvre (+350 km).
+        max_burn_m_s: Delta-v of the continuous action at +1 [m/s] (100).
+        revolutions_per_step: K, revolutions coasted per step (16: about one day).
+        horizon_steps: Mission length in steps (365: about a year); the
+            registered ``max_episode_steps``. Change both together.
+        propellant_cost_per_m_s: Reward cost of a burn [days per m/s] (0.4: the
+            whole tank is worth 120 days of mission, so burning without need costs,
+            and a burn that saves a mission pays many times over).
+        start_perigee_km: (low, high) of the uniform start perigee [km]
+            ((160, 500), the paper's range).
+        start_apogee_max_km: Upper end of the uniform start apogee, drawn between
+            the start perigee and this value [km] (1600, the paper's range).
+    """
+
+    drag_coefficient: float = 2.2
+    area_m2: float = 1.0
+    dry_mass_kg: float = 40.0
+    propellant_mass_kg: float = 6.0
+    isp_s: float = 220.0
+    burn_sizes_m_s: tuple[float, ...] = (0.0, 10.0, 30.0, 100.0)
+    max_burn_m_s: float = 100.0
+    revolutions_per_step: float = 16.0
+    horizon_steps: int = DEFAULT_HORIZON_STEPS
+    propellant_cost_per_m_s: float = 0.4
+    start_perigee_km: tuple[float, float] = (160.0, 500.0)
+    start_apogee_max_km: float = 1600.0
+
+    def __post_init__(self) -> None:
+        validate_satellite(
+            drag_coefficient=self.drag_coefficient,
+            area_m2=self.area_m2,
+            dry_mass_kg=self.dry_mass_kg,
+            propellant_mass_kg=self.propellant_mass_kg,
+            isp_s=self.isp_s,
+        )
+        sizes = tuple(self.burn_sizes_m_s) if isinstance(self.burn_sizes_m_s, (tuple, list)) else ()
+        _check(
+            "burn_sizes_m_s",
+            self.burn_sizes_m_s,
+            len(sizes) >= 1
+            and all(
+                isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= MAX_DV_CAPACITY_M_S for v in sizes
+            ),
+            f"a non-empty tuple of delta-v values in [0, {MAX_DV_CAPACITY_M_S:g}] m/s",
+        )
+        object.__setattr__(self, "burn_sizes_m_s", tuple(float(v) for v in sizes))
+        _check(
+            "max_burn_m_s",
+            self.max_burn_m_s,
+            isinstance(self.max_burn_m_s, (int, float)) and 0.0 < self.max_burn_m_s <= MAX_DV_CAPACITY_M_S,
+            f"a delta-v in (0, {MAX_DV_CAPACITY_M_S:g}] m/s",
+        )
+        _finite_positive("revolutions_per_step", self.revolutions_per_step)
+        _check(
+            "horizon_steps",
+            self.horizon_steps,
+            isinstance(self.horizon_steps, (int, np.integer)) and self.horizon_steps >= 1,
+            "an integer >= 1",
+        )
+        _check(
+            "propellant_cost_per_m_s",
+            self.propellant_cost_per_m_s,
+            isinstance(self.propellant_cost_per_m_s, (int, float))
+            and math.isfinite(self.propellant_cost_per_m_s)
+            and self.propellant_cost_per_m_s >= 0.0,
+            "a finite number of days per m/s >= 0",
+        )
+        lo_hi = tuple(self.start_perigee_km) if isinstance(self.start_perigee_km, (tuple, list)) else ()
+        floor_km, top_km = REENTRY_ALTITUDE_M / 1e3, CURVES_MAX_PERIGEE_M / 1e3
+        _check(
+            "start_perigee_km",
+            self.start_perigee_km,
+            len(lo_hi) == 2
+            and all(isinstance(v, (int, float)) and floor_km < v <= top_km for v in lo_hi)
+            and lo_hi[0] <= lo_hi[1],
+            f"(low, high) with {floor_km:g} < low <= high <= {top_km:g} km",
+        )
+        object.__setattr__(self, "start_perigee_km", (float(lo_hi[0]), float(lo_hi[1])))
+        _check(
+            "start_apogee_max_km",
+            self.start_apogee_max_km,
+            isinstance(self.start_apogee_max_km, (int, float))
+            and lo_hi[1] <= self.start_apogee_max_km <= CURVES_MAX_APOGEE_M / 1e3,
+            f"from the highest start perigee {lo_hi[1]:g} km to {CURVES_MAX_APOGEE_M / 1e3:g} km",
+        )
+
+    @property
+    def wet_mass_kg(self) -> float:
+        """Mass at the start [kg]."""
+        return self.dry_mass_kg + self.propellant_mass_kg
+
+    @property
+    def exhaust_velocity_m_s(self) -> float:
+        """Effective exhaust velocity Isp g0 [m/s]."""
+        return self.isp_s * G0_M_S2
+
+    @property
+    def drag_parameter_m2_kg(self) -> float:
+        """Drag parameter c = c_x F / m at the start [m^2/kg] (the paper's c of Eq. 4.1 over g)."""
+        return self.drag_coefficient * self.area_m2 / self.wet_mass_kg
+
+    @property
+    def delta_v_capacity_m_s(self) -> float:
+        """Delta-v of the full tank, Tsiolkovsky: Isp g0 ln(m_wet / m_dry) [m/s]."""
+        return self.exhaust_velocity_m_s * math.log(self.wet_mass_kg / self.dry_mass_kg)
+
+
+def validate_satellite(
+    *,
+    drag_coefficient: ArrayLike,
+    area_m2: ArrayLike,
+    dry_mass_kg: ArrayLike,
+    propellant_mass_kg: ArrayLike,
+    isp_s: ArrayLike,
+) -> None:
+    """Check a satellite (scalars or arrays); ValueError names the first bad value."""
+    for name, value in (
+        ("drag_coefficient", drag_coefficient),
+        ("area_m2", area_m2),
+        ("dry_mass_kg", dry_mass_kg),
+        ("isp_s", isp_s),
+    ):
+        array = np.asarray(value, dtype=np.float64)
+        bad = ~(np.isfinite(array) & (array > 0.0))
+        if bad.any():
+            raise ValueError(f"{name}={array[bad].flat[0].item()!r} is invalid; allowed: a finite number > 0")
+    propellant = np.asarray(propellant_mass_kg, dtype=np.float64)
+    bad = ~(np.isfinite(propellant) & (propellant >= 0.0))
+    if bad.any():
+        raise ValueError(
+            f"propellant_mass_kg={propellant[bad].flat[0].item()!r} is invalid; allowed: a finite number >= 0"
+        )
+    dry = np.asarray(dry_mass_kg, dtype=np.float64)
+    capacity = np.asarray(isp_s, dtype=np.float64) * G0_M_S2 * np.log1p(propellant / dry)
+    bad = capacity > MAX_DV_CAPACITY_M_S
+    if bad.any():
+        raise ValueError(
+            f"the satellite carries {np.broadcast_to(capacity, bad.shape)[bad].flat[0]:.0f} m/s of delta-v "
+            f"(isp_s, propellant_mass_kg, dry_mass_kg); allowed: up to {MAX_DV_CAPACITY_M_S:g} m/s"
+        )
