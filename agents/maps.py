@@ -15,7 +15,7 @@ import gymnasium
 import numpy as np
 
 import orbit_env  # noqa: F401  (registers the environments)
-from orbit_env.envs.orbit_raising import OrbitRaisingConfig
+from orbit_env.envs.config import OrbitRaisingConfig
 
 
 def start_observations(

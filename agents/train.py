@@ -18,6 +18,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+try:
+    from stable_baselines3.common.vec_env import VecEnvWrapper
+except ImportError as error:  # pragma: no cover - depends on the installation
+    raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
+
 from orbit_env.agents.shaping import SHAPINGS
 
 #: The hyperparameter file of the shipped model.
@@ -34,28 +39,24 @@ class TrainResult:
     timesteps: int
 
 
-def _mission_end_is_terminal(venv: Any) -> Any:
-    """Wrap ``venv`` so that the mission's end is terminal (see the class)."""
-    from stable_baselines3.common.vec_env import VecEnvWrapper
+class MissionEndIsTerminal(VecEnvWrapper):
+    """Treat the horizon as the end of the task: no value bootstrapped past it.
 
-    class MissionEndIsTerminal(VecEnvWrapper):
-        """Treat the horizon as the end of the task: no value bootstrapped past it.
+    The environments reward days *within* the mission and show the mission clock,
+    so the state at the horizon is terminal for the task; SB3 would otherwise add
+    the value of the life after the mission (Pardo et al. 2018, time limits in RL).
+    """
 
-        The environments reward days *within* the mission and show the mission clock,
-        so the state at the horizon is terminal for the task; SB3 would otherwise add
-        the value of the life after the mission (Pardo et al. 2018, time limits in RL).
-        """
+    def reset(self) -> Any:
+        """Reset the wrapped environments."""
+        return self.venv.reset()
 
-        def reset(self) -> Any:
-            return self.venv.reset()
-
-        def step_wait(self) -> Any:
-            obs, rewards, dones, infos = self.venv.step_wait()
-            for info in infos:
-                info.pop("TimeLimit.truncated", None)
-            return obs, rewards, dones, infos
-
-    return MissionEndIsTerminal(venv)
+    def step_wait(self) -> Any:
+        """Step, and drop SB3's truncation marks so that the horizon counts as terminal."""
+        obs, rewards, dones, infos = self.venv.step_wait()
+        for info in infos:
+            info.pop("TimeLimit.truncated", None)
+        return obs, rewards, dones, infos
 
 
 def load_config(path: str | Path | None = None) -> dict[str, Any]:
@@ -132,7 +133,7 @@ def train(
     seed = int(config["seed"])
     venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed)
     if not config.get("bootstrap_at_horizon", True):
-        venv = _mission_end_is_terminal(venv)
+        venv = MissionEndIsTerminal(venv)
     if config.get("shaping", "none") == "never_burn_value":
         from orbit_env.agents.shaping import never_burn_value_shaping
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from orbit_env.checks import check_array, check_int, check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
 
@@ -26,13 +27,12 @@ MAX_DV_CAPACITY_M_S = 3000.0
 DEFAULT_HORIZON_STEPS = 365
 
 
-def _check(name: str, value: Any, ok: bool, allowed: str) -> None:
-    if not ok:
-        raise ValueError(f"{name}={value!r} is invalid; allowed: {allowed}")
-
-
-def _finite_positive(name: str, value: Any) -> None:
-    _check(name, value, isinstance(value, (int, float)) and math.isfinite(value) and value > 0, "a finite number > 0")
+def _pair(value: Any, name: str, unit: str = "") -> tuple[float, float]:
+    """A (low, high) pair of numbers, low <= high; ValueError naming it otherwise."""
+    if not (isinstance(value, (tuple, list)) and len(value) == 2):
+        raise ValueError(f"{name}={value!r} is invalid; allowed: (low, high), two numbers")
+    low = check_number(value[0], f"{name}[0]", unit=unit)
+    return low, check_number(value[1], f"{name}[1]", unit=unit, low=low, low_name=f"{name}[0]")
 
 
 @dataclass(frozen=True)
@@ -58,23 +58,11 @@ class DensityConfig:
     cycle_period_days: float = 4018.0
 
     def __post_init__(self) -> None:
-        low_high = tuple(self.scale_range) if isinstance(self.scale_range, (tuple, list)) else ()
-        _check(
-            "scale_range",
-            self.scale_range,
-            len(low_high) == 2
-            and all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in low_high)
-            and low_high[0] <= low_high[1],
-            "(low, high) with 0 < low <= high",
-        )
-        object.__setattr__(self, "scale_range", (float(low_high[0]), float(low_high[1])))
-        _check(
-            "cycle_amplitude",
-            self.cycle_amplitude,
-            isinstance(self.cycle_amplitude, (int, float)) and 0.0 <= self.cycle_amplitude <= 5.0,
-            "0 to 5 (natural-log amplitude)",
-        )
-        _finite_positive("cycle_period_days", self.cycle_period_days)
+        low, high = _pair(self.scale_range, "scale_range")
+        check_number(low, "scale_range[0]", low=0.0, low_inclusive=False, why="a density scale")
+        object.__setattr__(self, "scale_range", (low, high))
+        check_number(self.cycle_amplitude, "cycle_amplitude", low=0.0, high=5.0, why="a natural-log amplitude")
+        check_number(self.cycle_period_days, "cycle_period_days", unit="days", low=0.0, low_inclusive=False)
 
     @property
     def nominal_scale(self) -> float:
@@ -147,55 +135,34 @@ class OrbitRaisingConfig:
             propellant_mass_kg=self.propellant_mass_kg,
             isp_s=self.isp_s,
         )
-        sizes = tuple(self.burn_sizes_m_s) if isinstance(self.burn_sizes_m_s, (tuple, list)) else ()
-        _check(
+        sizes = self.burn_sizes_m_s
+        if not (isinstance(sizes, (tuple, list)) and len(sizes) >= 1):
+            raise ValueError(f"burn_sizes_m_s={sizes!r} is invalid; allowed: a non-empty tuple of delta-v values")
+        dv_cap = {"unit": "m/s", "high": MAX_DV_CAPACITY_M_S, "why": "the most delta-v a satellite may carry"}
+        object.__setattr__(
+            self,
             "burn_sizes_m_s",
-            self.burn_sizes_m_s,
-            len(sizes) >= 1
-            and all(
-                isinstance(v, (int, float)) and math.isfinite(v) and 0.0 <= v <= MAX_DV_CAPACITY_M_S for v in sizes
-            ),
-            f"a non-empty tuple of delta-v values in [0, {MAX_DV_CAPACITY_M_S:g}] m/s",
+            tuple(check_number(v, f"burn_sizes_m_s[{i}]", low=0.0, **dv_cap) for i, v in enumerate(sizes)),
         )
-        object.__setattr__(self, "burn_sizes_m_s", tuple(float(v) for v in sizes))
-        _check(
-            "max_burn_m_s",
-            self.max_burn_m_s,
-            isinstance(self.max_burn_m_s, (int, float)) and 0.0 < self.max_burn_m_s <= MAX_DV_CAPACITY_M_S,
-            f"a delta-v in (0, {MAX_DV_CAPACITY_M_S:g}] m/s",
+        check_number(self.max_burn_m_s, "max_burn_m_s", low=0.0, low_inclusive=False, **dv_cap)
+        check_number(self.revolutions_per_step, "revolutions_per_step", low=0.0, low_inclusive=False)
+        check_int(self.horizon_steps, "horizon_steps", low=1)
+        check_number(self.propellant_cost_per_m_s, "propellant_cost_per_m_s", unit="days per m/s", low=0.0)
+        domain = "the universal curves' domain"
+        low_km, high_km = _pair(self.start_perigee_km, "start_perigee_km", "km")
+        check_number(
+            low_km, "start_perigee_km[0]", unit="km", low=REENTRY_ALTITUDE_M / 1e3, low_inclusive=False, why=domain
         )
-        _finite_positive("revolutions_per_step", self.revolutions_per_step)
-        _check(
-            "horizon_steps",
-            self.horizon_steps,
-            isinstance(self.horizon_steps, (int, np.integer)) and self.horizon_steps >= 1,
-            "an integer >= 1",
-        )
-        _check(
-            "propellant_cost_per_m_s",
-            self.propellant_cost_per_m_s,
-            isinstance(self.propellant_cost_per_m_s, (int, float))
-            and math.isfinite(self.propellant_cost_per_m_s)
-            and self.propellant_cost_per_m_s >= 0.0,
-            "a finite number of days per m/s >= 0",
-        )
-        lo_hi = tuple(self.start_perigee_km) if isinstance(self.start_perigee_km, (tuple, list)) else ()
-        floor_km, top_km = REENTRY_ALTITUDE_M / 1e3, CURVES_MAX_PERIGEE_M / 1e3
-        _check(
-            "start_perigee_km",
-            self.start_perigee_km,
-            len(lo_hi) == 2
-            and all(isinstance(v, (int, float)) and floor_km < v <= top_km for v in lo_hi)
-            and lo_hi[0] <= lo_hi[1],
-            f"(low, high) with {floor_km:g} < low <= high <= {top_km:g} km",
-        )
-        object.__setattr__(self, "start_perigee_km", (float(lo_hi[0]), float(lo_hi[1])))
-        _check(
-            "start_apogee_max_km",
+        check_number(high_km, "start_perigee_km[1]", unit="km", high=CURVES_MAX_PERIGEE_M / 1e3, why=domain)
+        object.__setattr__(self, "start_perigee_km", (low_km, high_km))
+        check_number(
             self.start_apogee_max_km,
-            isinstance(self.start_apogee_max_km, (int, float))
-            and lo_hi[1] <= self.start_apogee_max_km <= CURVES_MAX_APOGEE_M / 1e3,
-            f"from the highest start perigee {lo_hi[1]:g} km to {CURVES_MAX_APOGEE_M / 1e3:g} km",
+            "start_apogee_max_km",
+            unit="km",
+            low=high_km,
+            low_name="start_perigee_km[1]",
+            high=CURVES_MAX_APOGEE_M / 1e3,
+            why=domain,
         )
 
     @property
@@ -228,22 +195,12 @@ def validate_satellite(
     isp_s: ArrayLike,
 ) -> None:
     """Check a satellite (scalars or arrays); ValueError names the first bad value."""
-    for name, value in (
-        ("drag_coefficient", drag_coefficient),
-        ("area_m2", area_m2),
-        ("dry_mass_kg", dry_mass_kg),
-        ("isp_s", isp_s),
-    ):
-        array = np.asarray(value, dtype=np.float64)
-        bad = ~(np.isfinite(array) & (array > 0.0))
-        if bad.any():
-            raise ValueError(f"{name}={array[bad].flat[0].item()!r} is invalid; allowed: a finite number > 0")
-    propellant = np.asarray(propellant_mass_kg, dtype=np.float64)
-    bad = ~(np.isfinite(propellant) & (propellant >= 0.0))
-    if bad.any():
-        raise ValueError(
-            f"propellant_mass_kg={propellant[bad].flat[0].item()!r} is invalid; allowed: a finite number >= 0"
-        )
+    positive = {"low": 0.0, "low_inclusive": False}
+    check_array(drag_coefficient, "drag_coefficient", **positive)
+    check_array(area_m2, "area_m2", unit="m^2", **positive)
+    check_array(dry_mass_kg, "dry_mass_kg", unit="kg", **positive)
+    check_array(isp_s, "isp_s", unit="s", **positive)
+    propellant = check_array(propellant_mass_kg, "propellant_mass_kg", unit="kg", low=0.0)
     dry = np.asarray(dry_mass_kg, dtype=np.float64)
     capacity = np.asarray(isp_s, dtype=np.float64) * G0_M_S2 * np.log1p(propellant / dry)
     bad = capacity > MAX_DV_CAPACITY_M_S

@@ -472,39 +472,31 @@ def resolve_options(
             raise ValueError(f"reset option {name}={value!r} must be a number or an array of shape {shape}")
         if not np.all(np.isfinite(array)):
             raise ValueError(f"reset option {name}={value!r} must be finite")
-        merged[name] = float(array) if size is None else np.broadcast_to(array, shape).copy()
+        merged[name] = float(array) if array.shape == () else array.copy()  # a number pins every satellite
     if "perigee_km" in options and "apogee_km" not in options:
         # A pinned perigee above the drawn apogee makes the drawn orbit circular.
         merged["apogee_km"] = np.maximum(merged["apogee_km"], merged["perigee_km"])
-        if size is None:
-            merged["apogee_km"] = float(merged["apogee_km"])
     if "apogee_km" in options and "perigee_km" not in options:
         merged["perigee_km"] = np.minimum(merged["perigee_km"], merged["apogee_km"])
-        if size is None:
-            merged["perigee_km"] = float(merged["perigee_km"])
+    if size is None:
+        merged["perigee_km"], merged["apogee_km"] = float(merged["perigee_km"]), float(merged["apogee_km"])
     validate_satellite(**{name: merged[name] for name in SATELLITE_OPTIONS})
     domain = "the universal curves' domain"
+    # Checked together: a pinned apogee's bound is each satellite's perigee, drawn or pinned.
+    perigee_km, apogee_km = np.broadcast_arrays(merged["perigee_km"], merged["apogee_km"])
     check_array(
-        merged["perigee_km"],
-        "perigee_km",
-        unit="km",
-        low=REENTRY_ALTITUDE_M / 1e3,
-        high=CURVES_MAX_PERIGEE_M / 1e3,
-        why=domain,
+        perigee_km, "perigee_km", unit="km", low=REENTRY_ALTITUDE_M / 1e3, high=CURVES_MAX_PERIGEE_M / 1e3, why=domain
     )
     check_array(
-        merged["apogee_km"],
+        apogee_km,
         "apogee_km",
         unit="km",
-        low=merged["perigee_km"],
+        low=perigee_km,
         low_name="perigee_km",
         high=CURVES_MAX_APOGEE_M / 1e3,
         why=domain,
     )
-    scale = np.asarray(merged["density_scale"])
-    bad = ~(scale > 0.0)
-    if bad.any():
-        raise ValueError(f"reset option density_scale={scale[bad].flat[0].item()!r} is invalid; allowed: > 0")
+    check_array(merged["density_scale"], "density_scale", low=0.0, low_inclusive=False)
     return merged
 
 
@@ -539,7 +531,10 @@ def start(
     state.time_days = state.steps = 0.0
     state.perigee_drop_m = state.apogee_drop_m = 0.0
     update_satellite(task, state)
-    place(task, state, values["perigee_km"] * 1e3, values["apogee_km"] * 1e3)
+    perigee_m, apogee_m = values["perigee_km"] * 1e3, values["apogee_km"] * 1e3
+    if size is not None:
+        perigee_m, apogee_m = np.broadcast_to(perigee_m, (size,)), np.broadcast_to(apogee_m, (size,))
+    place(task, state, perigee_m, apogee_m)
     return state
 
 
