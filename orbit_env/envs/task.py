@@ -283,13 +283,15 @@ class BatchState:
             data = np.zeros((len(STATE_FIELDS) + SEGMENT_ROWS, int(data)))
             data[len(STATE_FIELDS)] = STALE_SEGMENT
         assert data.shape[0] == len(STATE_FIELDS) + SEGMENT_ROWS
-        self.__dict__["data"] = data
-        for name, row in zip(STATE_FIELDS, data, strict=False):
-            self.__dict__[name] = row
-        self.__dict__["segments"] = data[len(STATE_FIELDS) :]
+        views = self.__dict__
+        views.update(zip(STATE_FIELDS, data, strict=False))  # the rows as views, iterated in C
+        views["segments"] = data[len(STATE_FIELDS) :]
+        views["data"] = data
 
     def __setattr__(self, name: str, value: Any) -> None:
-        self.__dict__[name][...] = value
+        row = self.__dict__[name]
+        if value is not row:  # an augmented assignment (state.x += y) has already written the row
+            row[...] = value
 
     def __getstate__(self) -> tuple[FloatArray]:
         return (self.data,)  # the array once, not its row views (which would unpickle as copies)
@@ -304,7 +306,13 @@ class BatchState:
 
     def take(self, index: Any) -> BatchState:
         """A copy of the satellites at ``index`` (an index array or a boolean mask)."""
-        return BatchState(self.data[:, index])
+        if isinstance(index, np.ndarray) and index.dtype == np.bool_:
+            index = np.flatnonzero(index)
+        return BatchState(self.data.take(index, axis=1))
+
+    def rows(self, index: NDArray[np.intp]) -> SatelliteRows:
+        """The satellites at ``index``, read and written in place (no copy): a subset that burns."""
+        return SatelliteRows(self, index)
 
     def put(self, index: Any, other: BatchState) -> None:
         """Write ``other``'s satellites into the places ``index``."""
@@ -319,7 +327,45 @@ class BatchState:
         return {name: self.__dict__[name].copy() for name in STATE_FIELDS}
 
 
-AnyState = TaskState | BatchState
+class SatelliteRows:
+    """Some satellites of a :class:`BatchState`, in place: reading a field gathers it, assigning scatters it.
+
+    For the few satellites that burn in a step of thousands: the task functions run
+    on them as on a batch, and only the fields they touch are gathered and written.
+    """
+
+    __slots__ = ("_index", "_state")
+
+    def __init__(self, state: BatchState, index: NDArray[np.intp]) -> None:
+        self._state = state
+        self._index = index
+
+    @property
+    def segments(self) -> FloatArray:
+        """The satellites' cells of the curves' table (a copy)."""
+        return self._state.segments[:, self._index]
+
+    @segments.setter
+    def segments(self, value: FloatArray) -> None:
+        self._state.segments[:, self._index] = value
+
+
+def _field(name: str) -> property:
+    def get(rows: SatelliteRows) -> FloatArray:
+        return rows._state.__dict__[name].take(rows._index)
+
+    def put(rows: SatelliteRows, value: Any) -> None:
+        rows._state.__dict__[name][rows._index] = value
+
+    return property(get, put, doc=f"{name} of the satellites (read: a copy; assigned: written in place).")
+
+
+for _name in STATE_FIELDS:
+    setattr(SatelliteRows, _name, _field(_name))
+del _name
+
+
+AnyState = TaskState | BatchState | SatelliteRows
 
 
 # ---------------------------------------------------------------------------------
@@ -681,24 +727,20 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
     made = np.zeros(state.size)
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s))  # asked to burn, and able to
     if asked.size:
+        requested = requested_dv_m_s[asked] if np.ndim(requested_dv_m_s) else requested_dv_m_s
+        asking = state.rows(asked)
         dv, apogee_m, mass_kg = perigee_burn(
-            state.perigee_m[asked],
-            state.apogee_m[asked],
-            state.mass_kg[asked],
-            state.dry_mass_kg[asked],
-            state.exhaust_m_s[asked],
-            np.broadcast_to(requested_dv_m_s, made.shape)[asked],
+            asking.perigee_m, asking.apogee_m, asking.mass_kg, asking.dry_mass_kg, asking.exhaust_m_s, requested
         )
         fired = dv > 0.0
         if not fired.all():
             asked, dv, apogee_m, mass_kg = asked[fired], dv[fired], apogee_m[fired], mass_kg[fired]
         if asked.size:
             made[asked] = dv
-            firing = state.take(asked)
+            firing = state.rows(asked)
             firing.mass_kg = mass_kg
             update_satellite(task, firing)
             place(task, firing, firing.perigee_m, apogee_m)
-            state.put(asked, firing)
     return made
 
 
@@ -726,8 +768,11 @@ def coast(task: Task, state: AnyState, steps: Any = 1.0) -> Any:
         _point(state), revolutions * state.nu_per_rev, state.segments
     )
     days = (weighted_s - after.mean_period_s * after.nu) / (state.nu_per_rev * SECONDS_PER_DAY)
-    state.perigee_drop_m = state.perigee_m - perigee_m
-    state.apogee_drop_m = state.apogee_m - apogee_m
+    # The drops as heights before less heights after, written in place on a batch's rows.
+    state.perigee_drop_m = state.perigee_m
+    state.perigee_drop_m -= perigee_m
+    state.apogee_drop_m = state.apogee_m
+    state.apogee_drop_m -= apogee_m
     state.perigee_m = perigee_m
     state.apogee_m = apogee_m
     state.tau = after.tau
@@ -735,8 +780,8 @@ def coast(task: Task, state: AnyState, steps: Any = 1.0) -> Any:
     state.period_s = after.mean_period_s
     if isinstance(state, TaskState):
         state.point = after
-    state.time_days = state.time_days + days
-    state.steps = state.steps + steps
+    state.time_days += days  # in place on a batch's rows
+    state.steps += steps
     return days
 
 
