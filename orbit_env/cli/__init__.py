@@ -1,0 +1,46 @@
+"""The ``orbit-env`` command line.
+
+Lifetimes (one orbit or a CSV batch), disposal rules, density fits, Table II, Fig. 2,
+training and evaluating agents.
+One module per group of commands (:mod:`~orbit_env.cli.lifetime`, :mod:`~orbit_env.cli.paper`,
+:mod:`~orbit_env.cli.agents`), sharing :mod:`~orbit_env.cli.common`. Every error a user can
+cause ends in one line on stderr and exit status 2, in the command line's words.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+from orbit_env.checks import InputError
+from orbit_env.cli import agents, lifetime, paper
+from orbit_env.cli.common import FLAGS, PROG, Parser, in_flags
+
+__all__ = ["FLAGS", "PROG", "build_parser", "main"]
+
+
+def build_parser() -> Parser:
+    """The full ``orbit-env`` parser."""
+    parser = Parser(prog=PROG, description="Satellite decay by Okhotsimsky, Eneev and Taratynova (1957).")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    lifetime.add_parsers(sub)
+    paper.add_parsers(sub)
+    agents.add_parsers(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ValueError, ImportError, OSError) as error:
+        text = in_flags(error, args) if isinstance(error, InputError) else str(error)
+        message = text.splitlines()[0] if text else type(error).__name__
+        print(f"{PROG}: error: {message}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

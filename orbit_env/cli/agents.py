@@ -1,0 +1,71 @@
+"""``orbit-env train`` and ``orbit-env evaluate``: the agents of the orbit-raising environments."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from orbit_env.cli.common import positive_int
+
+
+def _cmd_train(args: argparse.Namespace) -> int:
+    from orbit_env.agents.train import train
+
+    result = train(args.config, args.out, total_timesteps=args.timesteps, progress=not args.no_progress)
+    print(f"trained {result.timesteps} timesteps in {result.seconds:.0f} s")
+    print(f"model: {result.model_path}  (tensorboard --logdir {result.log_dir})")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from orbit_env.agents.evaluate import all_policies, evaluate, format_table, paired_difference, plot_returns
+
+    def say(name: str) -> None:
+        if not args.json:
+            print(f"  running {name} ...", file=sys.stderr)
+
+    policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say)
+    results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
+    if args.plot:
+        plot_returns(results, args.env, args.plot)
+    # PPO against the best hand-coded policy, then against the optimum.
+    paired = {
+        "paired_difference": paired_difference(results),
+        "paired_to_dp": paired_difference(results, baseline="dp"),
+    }
+    if args.json:
+        out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}
+        out.update({key: pair for key, pair in paired.items() if pair is not None})
+        print(json.dumps(out))
+    else:
+        found = [pair for pair in paired.values() if pair is not None]
+        print(format_table(args.env, args.episodes, args.seed, table, found))
+    return 0
+
+
+def add_parsers(sub: Any) -> None:
+    """The ``train`` and ``evaluate`` commands."""
+    tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
+    tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
+    tr.add_argument("--out", default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)")
+    tr.add_argument("--timesteps", type=positive_int, metavar="N", help="override the config's total_timesteps")
+    tr.add_argument("--no-progress", action="store_true", help="no progress bar")
+    tr.set_defaults(func=_cmd_train)
+
+    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED
+
+    ev = sub.add_parser("evaluate", help="every policy on the same seeded episodes: when does a burn pay off?")
+    ev.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
+    ev.add_argument(
+        "--episodes", type=positive_int, default=EVAL_EPISODES, metavar="N", help=f"episodes (default {EVAL_EPISODES})"
+    )
+    ev.add_argument(
+        "--seed", type=int, default=EVAL_SEED, metavar="S", help=f"seed of the episodes (default {EVAL_SEED})"
+    )
+    ev.add_argument("--model", metavar="ZIP", help="PPO model (default: the shipped one for the environment)")
+    ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
+    ev.add_argument("--json", action="store_true", help="print one JSON object")
+    ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
+    ev.set_defaults(func=_cmd_evaluate)

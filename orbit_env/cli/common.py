@@ -1,0 +1,110 @@
+"""What every ``orbit-env`` command shares: one-line errors, numbers that remember how they were typed, flags.
+
+An error in a value names the flag and the value as typed (``--perigee 50 is out of
+range; allowed: 100 to 50000 km``): the API raises :class:`orbit_env.checks.InputError`
+naming its parameter, and :data:`FLAGS` maps the parameter to the flag at one place.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+from typing import Any, NoReturn
+
+from orbit_env.checks import InputError
+
+PROG = "orbit-env"
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line."""
+
+    def error(self, message: str) -> NoReturn:
+        """Exit with status 2 and the message on one line."""
+        self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
+
+
+def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
+    """Write rows of equal keys to a CSV file with a header."""
+    with open(path, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def given(args: argparse.Namespace, name: str) -> bool:
+    """Whether the flag ``name`` was given on the command line."""
+    value = getattr(args, name)
+    return value is not None and value is not False
+
+
+def flag(name: str) -> str:
+    """The flag of an argparse dest: ``scale_height_km`` -> ``--scale-height-km``."""
+    return "--" + name.replace("_", "-")
+
+
+class Typed(float):
+    """A number from the command line that remembers how it was typed (for messages)."""
+
+    text: str
+
+
+def number(text: str) -> float:
+    """The argparse type of number flags: a float that remembers its text."""
+    value = Typed(text)
+    value.text = text.strip()
+    return value
+
+
+number.__name__ = "number"  # argparse says "invalid number value: 'abc'"
+
+#: The API's parameter names (as :class:`~orbit_env.checks.InputError` gives them) -> the flag's
+#: argparse dest and, for a flag in other units than the parameter, the factor to the flag's unit and
+#: that unit. ``scale`` is an atmosphere's, ``phase`` :meth:`CycleActivity.with_phase`'s.
+FLAGS: dict[str, tuple[str, float, str | None]] = {
+    "perigee_km": ("perigee", 1.0, None),
+    "apogee_km": ("apogee", 1.0, None),
+    "drag_coefficient": ("cx", 1.0, None),
+    "mass_kg": ("mass", 1.0, None),
+    "area_m2": ("area", 1.0, None),
+    "mass_per_area_kg_m2": ("mass_per_area", 1.0, None),
+    "rho100_kg_m3": ("rho100", 1.0, None),
+    "density_scale": ("density_scale", 1.0, None),
+    "scale": ("density_scale", 1.0, None),
+    "rho0_kg_m3": ("rho0", 1.0, None),
+    "h0_m": ("h0_km", 1e-3, "km"),
+    "scale_height_m": ("scale_height_km", 1e-3, "km"),
+    "f107_sfu": ("f107", 1.0, None),
+    "f107a_sfu": ("f107a", 1.0, None),
+    "ap": ("ap", 1.0, None),
+    "phase": ("cycle_phase", 1.0, None),
+    "ascending_node_local_time_h": ("node_local_time", 1.0, None),
+    "chunk_days": ("chunk_days", 1.0, None),
+    "inclination_deg": ("inclination", 1.0, None),
+    "rule_years": ("rule", 1.0, None),
+    "reentry_sigma_days": ("reentry_sigma_days", 1.0, None),
+    "height_sigma_km": ("height_sigma_km", 1.0, None),
+}
+
+
+def in_flags(error: InputError, args: argparse.Namespace) -> str:
+    """The error in the command line's words: the flag, the value as typed, the flag's unit."""
+    if error.name not in FLAGS or error.index is not None or not hasattr(args, FLAGS[error.name][0]):
+        return str(error)  # not a flag's value (a file's cell, an element of a table)
+    dest, factor, unit = FLAGS[error.name]
+    typed = getattr(args, dest)
+    return error.message(
+        flag(dest),
+        value_text=typed.text if isinstance(typed, Typed) else None,
+        scale=factor,
+        unit=unit,
+        rename=lambda name: flag(FLAGS[name][0]) if name in FLAGS else name,
+    )
+
+
+def positive_int(text: str) -> int:
+    """The argparse type of counts: an integer >= 1."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
+    return value

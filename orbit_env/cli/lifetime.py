@@ -1,0 +1,291 @@
+"""``orbit-env lifetime`` (one orbit or a CSV catalogue) and ``orbit-env fit-density``: the analyst's commands.
+
+Heights are in km here and converted to SI at once; the batch CSV format is in
+:mod:`orbit_env.analysis.catalogue`, the solar CSV format in :mod:`orbit_env.decay.solar`,
+the observations of ``fit-density`` in :mod:`orbit_env.analysis.density_fit`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from typing import Any
+
+from orbit_env.analysis.lifetime import METHODS, Satellite, check_rule, lifetime, make_satellite
+from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
+from orbit_env.cli.common import flag, given, number, write_csv
+from orbit_env.decay.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
+from orbit_env.physics.atmosphere import ExponentialAtmosphere
+
+_MSIS_ONLY = ("f107", "f107a", "ap", "solar_csv", "solar_cycle", "cycle_phase", "epoch", "node_local_time")
+_EXPONENTIAL_ONLY = ("rho0", "h0_km", "scale_height_km")
+
+
+def _scenario(args: argparse.Namespace) -> Scenario:
+    """The atmosphere and solar activity chosen on the command line."""
+    kind = args.atmosphere
+    for name in _MSIS_ONLY:
+        if kind != "msis" and given(args, name):
+            raise ValueError(f"{flag(name)} applies to --atmosphere msis")
+    for name in _EXPONENTIAL_ONLY:
+        if kind != "exponential" and given(args, name):
+            raise ValueError(f"{flag(name)} applies to --atmosphere exponential")
+    if kind != "paper" and args.rho100 is not None:
+        raise ValueError("--rho100 applies to --atmosphere paper")
+    common = {
+        "density_scale": args.density_scale,
+        "rotating_atmosphere": args.rotating_atmosphere,
+        "chunk_days": args.chunk_days,
+    }
+    if kind == "paper":
+        return Scenario("paper", rho100_kg_m3=args.rho100, **common)
+    if kind == "exponential":
+        exponential = ExponentialAtmosphere(
+            1.3 if args.rho0 is None else args.rho0,
+            0.0 if args.h0_km is None else args.h0_km * 1e3,
+            8.5e3 if args.scale_height_km is None else args.scale_height_km * 1e3,
+        )
+        return Scenario(
+            "exponential",
+            rho0_kg_m3=exponential.rho0_kg_m3,
+            h0_m=exponential.h0_m,
+            scale_height_m=exponential.scale_height_m,
+            **common,
+        )
+    epoch = None if args.epoch is None else unix_days(args.epoch)
+    activity: SolarActivity
+    if args.solar_csv and args.solar_cycle:
+        raise ValueError("give either --solar-csv or --solar-cycle, not both")
+    if (args.solar_csv or args.solar_cycle) and (args.f107 is not None or args.f107a is not None):
+        raise ValueError("--f107/--f107a set constant activity; they do not combine with --solar-csv/--solar-cycle")
+    if args.cycle_phase is not None and not args.solar_cycle:
+        raise ValueError("--cycle-phase applies to --solar-cycle")
+    if args.solar_csv:
+        activity = read_solar_csv(args.solar_csv, default_ap=DEFAULT_AP if args.ap is None else args.ap)
+        if epoch is None:
+            epoch = activity.start_days
+    elif args.solar_cycle:
+        if epoch is None:
+            raise ValueError("--solar-cycle needs --epoch (the orbit's date; it sets the phase and the season)")
+        activity = CycleActivity() if args.cycle_phase is None else CycleActivity.with_phase(args.cycle_phase, epoch)
+    else:
+        f107 = 150.0 if args.f107 is None else args.f107
+        activity = ConstantActivity(
+            f107, f107 if args.f107a is None else args.f107a, 15.0 if args.ap is None else args.ap
+        )
+    return Scenario(
+        "msis", activity=activity, epoch_days=epoch, ascending_node_local_time_h=args.node_local_time, **common
+    )
+
+
+def _satellite(args: argparse.Namespace) -> Satellite:
+    return make_satellite(args.cx, args.mass, args.area, args.mass_per_area)
+
+
+def _cmd_lifetime(args: argparse.Namespace) -> int:
+    satellite = _satellite(args)
+    scenario = _scenario(args)
+    if args.batch:
+        return _lifetime_batch(args, satellite, scenario)
+    if args.out:
+        raise ValueError("--out goes with --batch (a single lifetime prints; --trajectory writes its history)")
+    if args.perigee is None or args.apogee is None:
+        raise ValueError("give --perigee and --apogee (or --batch CSV)")
+    # Default method: the averaged ODE (the reference) for a fixed atmosphere; for activity that changes
+    # in time, the time-stepped curves (the averaged reference then rebuilds NRLMSIS every day: minutes).
+    method = args.method or ("curves" if scenario.time_varying else "averaged")
+    options: dict[str, Any] = {
+        "satellite": satellite,
+        "method": method,
+        "rotating_atmosphere": args.rotating_atmosphere,
+        "inclination_deg": args.inclination,
+    }
+    if scenario.atmosphere == "paper":
+        options.update(rho100_kg_m3=args.rho100, density_scale=args.density_scale)
+    elif scenario.atmosphere == "exponential":
+        options["atmosphere"] = ExponentialAtmosphere(
+            scenario.rho0_kg_m3, scenario.h0_m, scenario.scale_height_m, args.density_scale
+        )
+    else:
+        options.update(
+            activity=scenario.solar,
+            epoch=scenario.epoch_days,
+            density_scale=args.density_scale,
+            ascending_node_local_time_h=args.node_local_time,
+            chunk_days=args.chunk_days,
+        )
+    result = lifetime(args.perigee, args.apogee, **options)
+    summary = result.to_dict()
+    rule = None
+    if args.rule is not None:
+        rule = check_rule(
+            args.perigee,
+            args.apogee,
+            args.rule,
+            satellite=satellite,
+            scenario=scenario,
+            inclination_deg=args.inclination,
+        )
+        summary.update(
+            rule_years=args.rule,
+            complies=bool(rule.complies[0]),
+            new_perigee_km=float(rule.new_perigee_m[0]) / 1e3,
+            dv_m_s=float(rule.dv_m_s[0]),
+        )
+    if args.trajectory:
+        write_csv(args.trajectory, result.history.rows())
+    if args.plot:
+        from orbit_env.analysis.plots import plot_history
+
+        plot_history(result, args.plot)
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    print(f"orbit              {result.perigee_km:g} x {result.apogee_km:g} km")
+    print(
+        f"satellite          c_x {satellite.drag_coefficient:g}, {satellite.mass_kg:g} kg, "
+        f"{satellite.area_m2:.4g} m^2 (G/F = {satellite.mass_per_area_kg_m2:.4g} kg/m^2)"
+    )
+    print(f"atmosphere         {scenario.describe(args.inclination)}")
+    print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
+    print(f"revolutions        {result.revolutions:.1f}")
+    print(f"lifetime           {result.days:.2f} days ({result.days / 365.25:.2f} years)")
+    print(f"perigee velocity   {result.perigee_velocity_m_s:.1f} m/s")
+    print(f"method             {result.method}")
+    if rule is not None:
+        if rule.complies[0]:
+            print(f"{args.rule:g}-year rule       complies (re-enters within {args.rule:g} years)")
+        else:
+            print(
+                f"{args.rule:g}-year rule       does not comply; smallest burn at apogee: {rule.dv_m_s[0]:.2f} m/s "
+                f"(retrograde), lowering the perigee to {rule.new_perigee_m[0] / 1e3:.1f} km"
+            )
+    return 0
+
+
+def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
+    from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
+
+    if not args.out:
+        raise ValueError("--batch needs --out CSV for the results")
+    if args.perigee is not None or args.apogee is not None:
+        raise ValueError("--batch reads the orbits from the file; do not give --perigee/--apogee")
+    for name in ("trajectory", "plot", "json"):
+        if given(args, name):
+            raise ValueError(f"{flag(name)} applies to a single lifetime, not to --batch")
+    if args.method is not None:
+        raise ValueError("--batch always uses the universal curves; do not give --method")
+    start = time.perf_counter()
+    rows, hp, ha, c, inc, status = read_batch(
+        args.batch, satellite.drag_coefficient, satellite.drag_parameter_m2_kg, args.inclination
+    )
+    records, summary = batch_lifetimes(
+        rows, hp, ha, c, inc, status, scenario, rule_years=args.rule, progress=not args.no_progress
+    )
+    write_records(args.out, records)
+    elapsed = time.perf_counter() - start
+    print(
+        f"wrote {summary.rows} rows to {args.out} ({summary.ok} with lifetimes, {summary.rows - summary.ok} with a "
+        f"status message) in {elapsed:.2f} s; atmosphere {scenario.describe(args.inclination)}"
+    )
+    return 0
+
+
+def _cmd_fit_density(args: argparse.Namespace) -> int:
+    from orbit_env.analysis.density_fit import fit_density_scale, read_observations
+
+    satellite = _satellite(args)
+    scenario = _scenario(args)
+    observations = read_observations(args.observations)
+    fit = fit_density_scale(
+        observations,
+        satellite=satellite,
+        scenario=scenario,
+        inclination_deg=args.inclination,
+        reentry=args.reentry,
+        reentry_sigma_days=args.reentry_sigma_days,
+        height_sigma_km=args.height_sigma_km,
+    )
+    if args.json:
+        print(json.dumps(fit.to_dict()))
+        return 0
+    low68, high68 = fit.interval(0.68)
+    low95, high95 = fit.interval(0.95)
+    print(f"atmosphere         {scenario.describe(args.inclination)}")
+    print(f"data               {fit.description}")
+    print(f"density scale      {fit.scale:.4g} (68%: {low68:.4g} to {high68:.4g}; 95%: {low95:.4g} to {high95:.4g})")
+    if fit.residual_rms_km is not None:
+        print(f"residuals          {fit.residual_rms_km:.3g} km rms")
+    return 0
+
+
+def _add_satellite_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("satellite")
+    group.add_argument("--cx", type=number, default=2.0, help="drag coefficient (default 2.0)")
+    group.add_argument("--mass", type=number, metavar="KG", help="mass [kg] (with --area; default the paper's 10 kg)")
+    group.add_argument("--area", type=number, metavar="M2", help="reference area [m^2] (default 0.5 m sphere)")
+    group.add_argument("--mass-per-area", type=number, metavar="KG_M2", help="transverse load G/F [kg/m^2]")
+
+
+def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_argument_group("atmosphere")
+    group.add_argument("--atmosphere", choices=ATMOSPHERES, default="paper", help="density model (default paper)")
+    group.add_argument("--rho100", type=number, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
+    group.add_argument("--density-scale", type=number, default=1.0, help="multiply the density (default 1)")
+    group.add_argument("--rho0", type=number, metavar="KG_M3", help="exponential: density at --h0-km (default 1.3)")
+    group.add_argument("--h0-km", type=number, metavar="KM", help="exponential: reference height (default 0)")
+    group.add_argument("--scale-height-km", type=number, metavar="KM", help="exponential: scale height (default 8.5)")
+    group.add_argument("--f107", type=number, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
+    group.add_argument("--f107a", type=number, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
+    group.add_argument("--ap", type=number, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
+    group.add_argument("--solar-csv", metavar="CSV", help="msis: F10.7 (f107a, ap) by date (see orbit_env.decay.solar)")
+    group.add_argument("--solar-cycle", action="store_true", help="msis: the built-in smooth solar cycle")
+    group.add_argument("--cycle-phase", type=number, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
+    group.add_argument(
+        "--epoch", metavar="DATE", help="msis: the orbit's date: follow the season and the activity from then on"
+    )
+    group.add_argument("--node-local-time", type=number, metavar="HOURS", help="msis: Sun-synchronous node local time")
+    group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")
+    group.add_argument("--rotating-atmosphere", action="store_true", help="air co-rotates with the Earth")
+    group.add_argument(
+        "--inclination", type=number, default=0.0, metavar="DEG", help="inclination (rotating air; msis latitudes)"
+    )
+
+
+def add_parsers(sub: Any) -> None:
+    """The ``lifetime`` and ``fit-density`` commands."""
+    life = sub.add_parser("lifetime", help="lifetime of a satellite on an orbit, to re-entry at 100 km perigee")
+    life.add_argument("--perigee", type=number, metavar="KM", help="perigee height [km]")
+    life.add_argument("--apogee", type=number, metavar="KM", help="apogee height [km]")
+    _add_satellite_options(life)
+    life.add_argument(
+        "--method",
+        choices=METHODS,
+        default=None,
+        help="averaged ODE, universal curves, or direct (default: averaged; curves when the solar activity "
+        "changes in time, where the averaged reference takes minutes)",
+    )
+    _add_atmosphere_options(life)
+    life.add_argument("--rule", type=number, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
+    life.add_argument(
+        "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
+    )
+    life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
+    life.add_argument("--no-progress", action="store_true", help="with --batch: no progress bar")
+    life.add_argument("--json", action="store_true", help="print one JSON object")
+    life.add_argument("--trajectory", metavar="CSV", help="write the decay history to a CSV file")
+    life.add_argument("--plot", metavar="PNG", help="plot the decay history")
+    life.set_defaults(func=_cmd_lifetime)
+
+    fit = sub.add_parser("fit-density", help="density scale factor from an observed decay (the paper's section 4)")
+    fit.add_argument("observations", metavar="OBS_CSV", help="observed orbits: date (or days), perigee_km, apogee_km")
+    fit.add_argument("--reentry", metavar="DATE", help="observed re-entry date: fit it from the first orbit")
+    fit.add_argument("--reentry-sigma-days", type=number, default=0.5, help="uncertainty of --reentry (default 0.5)")
+    fit.add_argument(
+        "--height-sigma-km", type=number, default=1.0, help="with --reentry: uncertainty of the first orbit's heights"
+    )
+    _add_satellite_options(fit)
+    _add_atmosphere_options(fit)
+    fit.add_argument("--json", action="store_true", help="print one JSON object")
+    fit.set_defaults(func=_cmd_fit_density)
