@@ -15,12 +15,12 @@ from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import Task, TaskState
+from orbit_env.envs.task import Task, TaskState, TaskView
 
 __all__ = ["DEFAULT_HORIZON_STEPS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv"]
 
 
-class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
+class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     r"""Keep a satellite in orbit against drag with perigee burns.
 
     ## Description
@@ -169,21 +169,6 @@ class OrbitRaisingEnv(gym.Env[np.ndarray, Any]):
         self._track: list[tuple[float, float, float]] = []  # (perigee, apogee, burn) for render()
         self._last_burn_m_s = 0.0
         self._renderer: Any = None
-
-    @property
-    def config(self) -> OrbitRaisingConfig:
-        """The satellite and the mission."""
-        return self.task.config
-
-    @property
-    def density(self) -> DensityConfig:
-        """The density knowledge."""
-        return self.task.density
-
-    @property
-    def continuous(self) -> bool:
-        """Whether the action is the continuous burn size."""
-        return self.task.continuous
 
     # The universal curves are not an attribute: universal_curves() is the process's
     # one cached table, so a pickled env carries only its own state. Neither does it

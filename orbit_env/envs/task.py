@@ -207,6 +207,27 @@ class Task:
         return np.maximum(index, 0).astype(np.int64)
 
 
+class TaskView:
+    """The task's parts as attributes of an environment that holds a :class:`Task` as ``self.task``."""
+
+    task: Task
+
+    @property
+    def config(self) -> OrbitRaisingConfig:
+        """The satellite and the mission."""
+        return self.task.config
+
+    @property
+    def density(self) -> DensityConfig:
+        """The density knowledge."""
+        return self.task.density
+
+    @property
+    def continuous(self) -> bool:
+        """Whether the action is the continuous burn size."""
+        return self.task.continuous
+
+
 # ---------------------------------------------------------------------------------
 # The state: Python floats for one satellite, rows of one array for many.
 # ---------------------------------------------------------------------------------

@@ -20,12 +20,12 @@ from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import BatchState, Task
+from orbit_env.envs.task import BatchState, Task, TaskView
 
 FloatArray = NDArray[np.float64]
 
 
-class OrbitRaisingVectorEnv(VectorEnv):
+class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     """``num_envs`` independent orbit-raising missions stepped together with numpy.
 
     Observation, action, reward and episode end are those of
@@ -87,21 +87,6 @@ class OrbitRaisingVectorEnv(VectorEnv):
         self._last_obs = np.zeros((self.num_envs, 7), dtype=np.float32)  # for reset_mask
         self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
         self._everyone_mask.flags.writeable = False
-
-    @property
-    def config(self) -> OrbitRaisingConfig:
-        """The satellite and the mission."""
-        return self.task.config
-
-    @property
-    def density(self) -> DensityConfig:
-        """The density knowledge."""
-        return self.task.density
-
-    @property
-    def continuous(self) -> bool:
-        """Whether the action is the continuous burn size."""
-        return self.task.continuous
 
     @property
     def state(self) -> dict[str, FloatArray]:
