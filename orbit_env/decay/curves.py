@@ -104,8 +104,8 @@ class _Grid:
         self.y_scale, self.y_offset = 1.0 / dy, y0 / dy
         self.x_top, self.y_top = nx - 1.000001, ny - 1.000001
 
-    def values(self, x: ArrayLike, y: ArrayLike) -> list[FloatArray]:
-        """The k tables at the points (x, y) (arrays that broadcast against each other)."""
+    def _cells(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, NDArray[np.intp], FloatArray]:
+        """Each point's cell (clamped to the grid): its coefficients (..., k, 4), tx, the y index j, ty."""
         fx = np.asarray(np.multiply(x, self.x_scale))  # an array even for 0-d input (the in-place clamps)
         fx -= self.x_offset
         np.maximum(fx, 0.0, out=fx)
@@ -121,6 +121,11 @@ class _Grid:
         ty = fy - j
         i *= self.ny
         cell = self.cells.take(i + j, axis=0)
+        return cell, tx, j, ty
+
+    def values(self, x: ArrayLike, y: ArrayLike) -> list[FloatArray]:
+        """The k tables at the points (x, y) (arrays that broadcast against each other)."""
+        cell, tx, _, ty = self._cells(x, y)
         txy = tx * ty
         out = []
         for m in range(self.k):
@@ -142,21 +147,7 @@ class _Grid:
         index j (as a float), then the k bases c0 + c1 tx, then the k slopes
         c2 + c3 tx; and ty, where y is in its cell. :meth:`along` evaluates them.
         """
-        fx = np.asarray(np.multiply(x, self.x_scale))
-        fx -= self.x_offset
-        np.maximum(fx, 0.0, out=fx)
-        np.minimum(fx, self.x_top, out=fx)
-        fy = np.asarray(np.multiply(y, self.y_scale))
-        if self.y_offset:
-            fy -= self.y_offset
-        np.maximum(fy, 0.0, out=fy)
-        np.minimum(fy, self.y_top, out=fy)
-        i = fx.astype(np.intp)
-        tx = fx - i
-        j = fy.astype(np.intp)
-        ty = fy - j
-        i *= self.ny
-        cell = self.cells.take(i + j, axis=0)
+        cell, tx, j, ty = self._cells(x, y)
         out = np.empty((1 + 2 * self.k, *tx.shape))
         out[0] = j
         for m in range(self.k):
