@@ -33,7 +33,6 @@ in time order.
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,11 +40,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize, stats
 
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.checks import InputError, check_number
+from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.csvfile import read_csv
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import unix_days
 from orbit_env.physics.orbit import elements_from_heights, period_s
@@ -55,42 +54,126 @@ FloatArray = NDArray[np.float64]
 
 @dataclass(frozen=True)
 class Observations:
-    """Observed orbits: time [days from any origin], perigee and apogee heights [km]."""
+    """Observed orbits: time [days], perigee and apogee heights [km].
+
+    Attributes:
+        days: Times, strictly increasing: unix days (``axis="date"``) or days from any origin.
+        perigee_km: Perigee heights.
+        apogee_km: Apogee heights.
+        source: Where they came from (for messages).
+        axis: ``"date"`` (the file gave dates) or ``"days"`` (it gave days); a re-entry
+            given as text must be on the same axis.
+        lines: The file's line of each observation (for messages), if read from a file.
+    """
 
     days: FloatArray
     perigee_km: FloatArray
     apogee_km: FloatArray
     source: str = "observations"
+    axis: str = "days"
+    lines: tuple[int, ...] | None = None
+
+    def where(self, index: int) -> str:
+        """``file, line N`` (or ``observations, observation N``) of one observation."""
+        if self.lines is None:
+            return f"{self.source}, observation {index + 1}"
+        return f"{self.source}, line {self.lines[index]}"
 
 
 def read_observations(path: str | Path) -> Observations:
     """Read observed orbits (format in the module docstring).
 
     Raises:
-        ValueError: missing columns, unreadable values, times not increasing.
+        ValueError: missing columns, both a ``date`` and a ``days`` column, unreadable
+            values, dates outside 1957-2200, times not increasing; the message names the
+            file and the line.
     """
-    source = str(path)
-    with open(path, newline="") as handle:
-        reader = csv.DictReader(handle)
-        header = [name.strip().lower() for name in reader.fieldnames or []]
-        rows = [{(k or "").strip().lower(): (v or "").strip() for k, v in row.items()} for row in reader]
-    for required in ("perigee_km", "apogee_km"):
-        if required not in header:
-            raise ValueError(f"{source}: the observations need a '{required}' column, found {header}")
-    if "date" not in header and "days" not in header:
-        raise ValueError(f"{source}: the observations need a 'date' or a 'days' column, found {header}")
-    if not rows:
-        raise ValueError(f"{source}: no observations")
-    days, hp, ha = (np.empty(len(rows)) for _ in range(3))
-    for i, row in enumerate(rows):
+    table = read_csv(path)
+    source = table.source
+    table.require("perigee_km", "apogee_km", what="the observations")
+    if "date" in table.header and "days" in table.header:
+        raise ValueError(
+            f"{source}: the times are in two columns, 'date' and 'days'; keep one (one time axis for every row)"
+        )
+    if "date" not in table.header and "days" not in table.header:
+        raise ValueError(
+            f"{source}: the observations need a 'date' or a 'days' column; its header has {', '.join(table.header)}"
+        )
+    axis = "date" if "date" in table.header else "days"
+    if not table.rows:
+        raise ValueError(f"{source}: the file has a header but no observations")
+    n = len(table.rows)
+    days, hp, ha = (np.empty(n) for _ in range(3))
+    for i, row in enumerate(table.rows):
+        where = row.where(source)
+        if row.extra:
+            raise ValueError(f"{where}: more cells than the header has columns (extra: {', '.join(row.extra)[:40]})")
         try:
-            days[i] = unix_days(row["date"]) if row.get("date") else float(row["days"])
-            hp[i], ha[i] = float(row["perigee_km"]), float(row["apogee_km"])
-        except (ValueError, KeyError) as error:
-            raise ValueError(f"{source}, line {i + 2}: {error}") from None
-    if np.any(np.diff(days) <= 0):
-        raise ValueError(f"{source}: observation times must be strictly increasing")
-    return Observations(days, hp, ha, source)
+            text = row.cells[axis]
+            if axis == "date":
+                days[i] = check_date(unix_days(text), "date", text=text)
+            else:
+                days[i] = check_number(_float(text), "days", unit="days")
+            hp[i] = check_number(_float(row.cells["perigee_km"]), "perigee_km", unit="km")
+            ha[i] = check_number(_float(row.cells["apogee_km"]), "apogee_km", unit="km")
+        except ValueError as error:
+            raise ValueError(f"{where}: {error}") from None
+    for i in np.flatnonzero(np.diff(days) <= 0):
+        raise ValueError(
+            f"{table.rows[i + 1].where(source)}: the time is not after line {table.rows[i].line}'s; "
+            "observations go in time order, one per time"
+        )
+    return Observations(days, hp, ha, source, axis, tuple(row.line for row in table.rows))
+
+
+def _float(text: str) -> float | str:
+    """A cell as a float, or the text itself (which check_number then refuses by name)."""
+    try:
+        return float(text)
+    except ValueError:
+        return text if text else "(empty)"
+
+
+def reentry_days(reentry: str | float, observations: Observations, name: str = "reentry") -> float:
+    """The re-entry on the observations' time axis [days].
+
+    Args:
+        reentry: A date (``YYYY-MM-DD``) for dated observations, a number of days for
+            observations in days (as text or a number); a number is always read on the
+            observations' axis (unix days for dated ones).
+        observations: The observations it belongs to.
+        name: The parameter or flag, for messages (``"--reentry"``).
+
+    Raises:
+        ValueError: a date for observations in days, a number typed as text for dated
+            observations (the message names both), or an unreadable or out-of-range date.
+    """
+    if not isinstance(reentry, str):
+        return check_number(reentry, name, unit="days")
+    text = reentry.strip()
+    label = f"{name} {text}" if name.startswith("-") else f"{name}={text!r}"
+    try:
+        number: float | None = float(text)
+    except ValueError:
+        number = None
+    if observations.axis == "days":
+        if number is None:
+            try:
+                unix_days(text)
+                kind = "is a date"
+            except ValueError:
+                kind = "is not a number of days"
+            raise ValueError(
+                f"{label} {kind}, but {observations.source} gives its times in days (a 'days' column); "
+                "give the re-entry in days on that axis"
+            )
+        return check_number(number, name, unit="days")
+    if number is not None:
+        raise ValueError(
+            f"{label} is a number, but {observations.source} gives its times as dates (a 'date' column); "
+            "give the re-entry as a date, YYYY-MM-DD"
+        )
+    return check_date(unix_days(text), name, text=text)
 
 
 @dataclass(frozen=True)
@@ -114,6 +197,8 @@ class DensityFit:
     def interval(self, level: float = 0.68) -> tuple[float, float]:
         """Central interval of s at probability ``level`` (symmetric in ln s)."""
         tail = 0.5 + 0.5 * level
+        from scipy import stats  # on use: start-up
+
         quantile = float(stats.norm.ppf(tail) if self.dof is None else stats.t.ppf(tail, self.dof))
         return self.scale * math.exp(-quantile * self.sigma_log), self.scale * math.exp(quantile * self.sigma_log)
 
@@ -185,10 +270,9 @@ def fit_density_scale(
         hp, ha = UniversalCurves.check_domain_km(observations.perigee_km, observations.apogee_km)
     except InputError as error:
         row = error.index[0] if error.index else 0
-        raise ValueError(f"{observations.source}, observation {row + 1}: {error.message(show_index=False)}") from None
+        raise ValueError(f"{observations.where(row)}: {error.message(show_index=False)}") from None
     if reentry is not None:
-        t_reentry = unix_days(reentry) if isinstance(reentry, str) else check_number(reentry, "reentry", unit="days")
-        dt_days = t_reentry - float(observations.days[0])
+        dt_days = reentry_days(reentry, observations) - float(observations.days[0])
         if not dt_days > 0:
             raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
         check_number(reentry_sigma_days, "reentry_sigma_days", unit="days", low=0.0)
@@ -216,6 +300,8 @@ def fit_density_scale(
         return np.concatenate([p_hp, p_ha]) / 1e3
 
     start = _initial_log_scale(curves, hp, ha, gc_dt)
+    from scipy import optimize  # on use: start-up
+
     solution = optimize.least_squares(
         lambda theta: predicted_km(theta) - observed,
         x0=np.array([start, hp[0] / 1e3, ha[0] / 1e3]),

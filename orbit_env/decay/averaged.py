@@ -46,7 +46,6 @@ from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from orbit_env.checks import check_int, check_number
 from orbit_env.constants import (
@@ -178,6 +177,8 @@ def integrate_averaged(
         p_grid = np.array([p0])
         states = np.array([[e0], [0.0], [0.0]])
     else:
+        from scipy.integrate import solve_ivp  # on use: half a second of start-up
+
         solution = solve_ivp(
             rhs,
             (p0, p_end_bound),

@@ -41,7 +41,6 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from orbit_env.checks import check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
@@ -361,6 +360,8 @@ def integrate_reference(
     reentry.terminal = True  # type: ignore[attr-defined]
     p0, e0 = (float(x) for x in elements_from_heights(perigee_m, apogee_m))
     t_max = model.max_years * 365.25 * SECONDS_PER_DAY
+    from scipy.integrate import solve_ivp  # on use: half a second of start-up
+
     solution = solve_ivp(
         rhs,
         (0.0, t_max),

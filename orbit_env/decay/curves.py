@@ -41,8 +41,8 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import CubicSpline
 
+from orbit_env import cache
 from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel
@@ -281,6 +281,19 @@ class UniversalCurves:
     def __init__(self, model: DecayModel) -> None:
         self.model = model
         self.labels = np.arange(_LOWEST_LABEL, np.log(_eccentricity(REENTRY_ALTITUDE_M, _HA_TOP_M)), _LABEL_SPACING)
+        # Half a second to integrate: kept on disk per model (orbit_env.cache).
+        description = cache.describe(model)
+        tables = cache.load("curves", description, __file__)
+        if tables is None:
+            tables = self._build()
+            cache.store("curves", description, __file__, tables)
+        label0 = float(self.labels[0])
+        self._table_a = _Grid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
+        self._table_b = _Grid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
+        self._table_q = _Grid(tables["b"][2:], label0, _LABEL_SPACING, 0.0, _DTAU)  # the mean period alone
+
+    def _build(self) -> dict[str, FloatArray]:
+        """Integrate the family and make its two tables: A (orbit -> curve, place) and B (curve, place -> orbit)."""
         tau = np.arange(0.0, _TAU_TOP + _DTAU, _DTAU)
         hp, y, weighted = self._integrate(tau, self.labels)
         nu = NU_REF * np.expm1(tau)
@@ -289,11 +302,7 @@ class UniversalCurves:
         # At re-entry W/nu is the period itself.
         e_end = np.exp(self.labels)
         q[:, 0] = period_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
-        label0 = float(self.labels[0])
-        self._table_a = _Grid(self._build_table_a(hp, y, tau), REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
-        table_b = self._build_table_b(hp, y, q)
-        self._table_b = _Grid(table_b, label0, _LABEL_SPACING, 0.0, _DTAU)
-        self._table_q = _Grid(table_b[2:], label0, _LABEL_SPACING, 0.0, _DTAU)  # the mean period alone
+        return {"a": self._build_table_a(hp, y, tau), "b": self._build_table_b(hp, y, q)}
 
     def _slope(self, hp: FloatArray, y: FloatArray, dnu_dtau: float | FloatArray) -> FloatArray:
         """d/dtau of perigee height, ln(e) and W, backward from re-entry, one curve each."""
@@ -349,6 +358,8 @@ class UniversalCurves:
         through the crossings. Beyond the lowest curve (more nearly circular
         orbits) the curves are translates of it: its values at the same height.
         """
+        from scipy.interpolate import CubicSpline  # on use: half a second of start-up
+
         labels = self.labels
         y_grid = np.arange(labels[0], np.nanmax(y), _DY)
         hp_grid = np.arange(REENTRY_ALTITUDE_M, _HP_TOP_M, _DH_M)

@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from orbit_env.checks import check_int, check_number
 from orbit_env.constants import (
@@ -279,6 +278,8 @@ def integrate_direct(
     # drag: twice the cap's worth of initial periods cannot end before the cap.
     p0_m, e0 = elements_from_heights(hp, ha)
     t_bound_s = 2.0 * (max_revs + 1.0) * float(period_s(p0_m, e0))
+    from scipy.integrate import solve_ivp  # on use: half a second of start-up
+
     solution = solve_ivp(
         rhs,
         (0.0, t_bound_s),

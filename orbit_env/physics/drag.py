@@ -47,7 +47,6 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.special import erf
 
 FloatArray = NDArray[np.float64]
 
@@ -100,6 +99,8 @@ def plate_drag_coefficient(
     s = np.asarray(speed_ratio_, dtype=np.float64)
     p = np.exp(-((g * s) ** 2)) / s
     q = 1.0 + 0.5 / (s * s)
+    from scipy.special import erf  # on use: a third of a second of start-up
+
     z = 1.0 + erf(g * s)
     v_ratio = reemission_speed_ratio(s, wall_to_gas_temperature, accommodation)
     return p / _SQRT_PI + g * q * z + 0.5 * g * v_ratio * (g * _SQRT_PI * z + p)
@@ -116,6 +117,8 @@ def sphere_drag_coefficient(
     """
     s = np.asarray(speed_ratio_, dtype=np.float64)
     s2 = s * s
+    from scipy.special import erf
+
     incident = (2.0 * s2 + 1.0) * np.exp(-s2) / (_SQRT_PI * s2 * s) + (4.0 * s2 * s2 + 4.0 * s2 - 1.0) * erf(s) / (
         2.0 * s2 * s2
     )

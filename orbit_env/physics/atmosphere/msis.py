@@ -64,6 +64,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env import cache
 from orbit_env.checks import check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, EARTH_RADIUS_M
 
@@ -231,6 +232,16 @@ def mean_density_over_days_kg_m3(
 
 
 @lru_cache(maxsize=256)
+def _cached_log_density_table(*conditions: float | None) -> FloatArray:
+    """:func:`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""
+    description = cache.describe(conditions)
+    table = cache.load("msis", description, __file__)
+    if table is None:
+        table = {"log_density": _log_density_table(*conditions)}
+        cache.store("msis", description, __file__, table)
+    return table["log_density"]
+
+
 def _log_density_table(
     f107_sfu: float,
     f107a_sfu: float,
@@ -300,7 +311,7 @@ class MsisAtmosphere:
 
     def log_density_table(self) -> FloatArray:
         """ln(density [kg/m^3]) on ``ALTITUDE_GRID_M``, without ``scale`` (cached)."""
-        return _log_density_table(
+        return _cached_log_density_table(
             float(self.f107_sfu),
             float(self.f107a_sfu),
             float(self.ap),

@@ -1,0 +1,136 @@
+"""A disk cache for the tables that take long to build: universal curves, NRLMSIS profiles, DP solutions.
+
+Each entry is one compressed ``.npz`` file of named arrays in the user's cache folder
+(``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux),
+under a name made from a hash of everything that shapes the table: its kind, a
+description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
+the source of the module that builds it, the package's version and
+:data:`FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
+never read (old files stay until the cache folder is cleared).
+
+Writes are atomic: a table is written to a temporary file in the same folder and
+renamed over its name, so processes that race build the same table twice at most
+and never read a half-written one. A cache that cannot be read or written (a
+read-only home, a full disk) is passed over: the table is built in memory.
+
+Control:
+
+* the environment variable ``ORBIT_ENV_CACHE_DIR``: a folder to use instead, or
+  ``off`` to disable the cache;
+* :func:`disable` (what ``orbit-env --no-cache`` calls) for the current process.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+import os
+import tempfile
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+#: The environment variable that moves (a folder) or disables (``off``) the cache.
+ENV_VAR = "ORBIT_ENV_CACHE_DIR"
+#: Bumped when the layout of a cached table changes.
+FORMAT_VERSION = 1
+
+_disabled = False
+
+
+def disable() -> None:
+    """Neither read nor write the cache in this process (``orbit-env --no-cache``)."""
+    global _disabled
+    _disabled = True
+
+
+def cache_dir() -> Path | None:
+    """The cache folder, or None when the cache is disabled."""
+    setting = os.environ.get(ENV_VAR, "").strip()
+    if _disabled or setting.lower() in ("off", "0", "false", "no"):
+        return None
+    if setting:
+        return Path(setting).expanduser()
+    from platformdirs import user_cache_dir
+
+    return Path(user_cache_dir("orbit-env", appauthor=False))
+
+
+def describe(value: Any) -> str | None:
+    """A stable description of a table's inputs, or None if there is none (then nothing is cached).
+
+    Frozen dataclasses whose fields are numbers, strings, None or such dataclasses
+    (and tuples of them) describe themselves by their ``repr``; anything else (a
+    user's function, an array) has no stable description.
+    """
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return repr(value)
+    if isinstance(value, tuple):
+        parts = [describe(v) for v in value]
+        return None if None in parts else "(" + ", ".join(parts) + ")"  # type: ignore[arg-type]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        parts = []
+        for item in dataclasses.fields(value):
+            if not item.repr:
+                continue
+            text = describe(getattr(value, item.name))
+            if text is None:
+                return None
+            parts.append(f"{item.name}={text}")
+        return f"{type(value).__qualname__}({', '.join(parts)})"
+    return None
+
+
+@functools.lru_cache(maxsize=32)
+def _source_digest(builder_file: str) -> str:
+    return hashlib.sha256(Path(builder_file).read_bytes()).hexdigest()
+
+
+def _path(kind: str, description: str, builder_file: str) -> Path | None:
+    folder = cache_dir()
+    if folder is None:
+        return None
+    from orbit_env import __version__
+
+    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{_source_digest(builder_file)}|{description}"
+    return folder / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
+
+
+def load(kind: str, description: str | None, builder_file: str) -> dict[str, np.ndarray] | None:
+    """The cached arrays of a table, or None (not cached, no description, cache disabled or unreadable).
+
+    Args:
+        kind: The kind of table (``"curves"``, ``"msis"``, ``"dp"``): the file's prefix.
+        description: What shapes the table (:func:`describe`); None: not cacheable.
+        builder_file: The ``__file__`` of the module that builds the table (its source is in the key).
+    """
+    path = None if description is None else _path(kind, description, builder_file)
+    if path is None or not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            return {name: data[name] for name in data.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError):
+        return None  # unreadable (truncated by a crash, another format): built again and rewritten
+
+
+def store(kind: str, description: str | None, builder_file: str, arrays: dict[str, np.ndarray]) -> None:
+    """Write a table's arrays to the cache, atomically; a cache that cannot be written is passed over."""
+    path = None if description is None else _path(kind, description, builder_file)
+    if path is None:
+        return
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
+        try:
+            with os.fdopen(handle, "wb") as file:
+                np.savez_compressed(file, **arrays)
+            os.replace(temporary, path)
+        except BaseException:
+            Path(temporary).unlink(missing_ok=True)
+            raise
+    except OSError:
+        return

@@ -1,0 +1,60 @@
+"""The disk cache of long-built tables (orbit_env.cache): keyed by their inputs, atomic, movable, can be disabled."""
+
+import numpy as np
+import pytest
+
+from orbit_env import cache
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.curves import UniversalCurves
+from orbit_env.physics.atmosphere import ExponentialAtmosphere, FunctionAtmosphere, PaperAtmosphere
+
+
+@pytest.fixture
+def folder(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.ENV_VAR, str(tmp_path))
+    return tmp_path
+
+
+def test_descriptions_name_every_input_and_refuse_what_has_none():
+    assert cache.describe(DecayModel()) == cache.describe(DecayModel(PaperAtmosphere()))
+    assert cache.describe(DecayModel(PaperAtmosphere(scale=2.0))) != cache.describe(DecayModel())
+    assert cache.describe(DecayModel(rotating_atmosphere=True)) != cache.describe(DecayModel())
+    assert cache.describe((1.0, None, 2)) == "(1.0, None, 2)"
+    # A user's function has no stable description: such a model is never cached.
+    assert cache.describe(DecayModel(FunctionAtmosphere(lambda h: np.exp(-h / 8e3)))) is None
+    assert cache.describe(np.zeros(3)) is None
+
+
+def test_curves_are_stored_once_and_read_back_identical(folder):
+    model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 60e3))
+    built = UniversalCurves(model)
+    files = list(folder.glob("curves-*.npz"))
+    assert len(files) == 1 and not list(folder.glob("*.tmp"))
+    loaded = UniversalCurves(model)
+    np.testing.assert_array_equal(loaded._table_a.cells, built._table_a.cells)
+    np.testing.assert_array_equal(loaded._table_b.cells, built._table_b.cells)
+    # Another model is another file.
+    UniversalCurves(DecayModel(ExponentialAtmosphere(2e-11, 400e3, 60e3)))
+    assert len(list(folder.glob("curves-*.npz"))) == 2
+
+
+def test_a_damaged_file_is_built_again(folder):
+    model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 50e3))
+    built = UniversalCurves(model)
+    (path,) = folder.glob("curves-*.npz")
+    path.write_bytes(b"not a zip file")
+    again = UniversalCurves(model)
+    np.testing.assert_array_equal(again._table_b.cells, built._table_b.cells)
+    assert cache.load("curves", cache.describe(model), cache.__file__) is None  # another builder: another key
+    with np.load(path) as data:  # rewritten whole
+        assert set(data.files) == {"a", "b"}
+
+
+def test_the_cache_can_be_disabled(tmp_path, monkeypatch):
+    monkeypatch.setenv(cache.ENV_VAR, "off")
+    assert cache.cache_dir() is None
+    UniversalCurves(DecayModel(ExponentialAtmosphere(1e-11, 400e3, 45e3)))
+    assert not list(tmp_path.iterdir())
+    monkeypatch.setenv(cache.ENV_VAR, str(tmp_path))
+    monkeypatch.setattr(cache, "_disabled", True)  # what orbit-env --no-cache sets
+    assert cache.cache_dir() is None
