@@ -5,7 +5,8 @@ Targets (issue 3): the single env through ``gymnasium.make`` at least 0.5x
 Gymnasium's ``CartPoleVectorEnv`` at 4096 envs.
 
 Both sides get uniformly random actions drawn beforehand (so the action sampler is
-not timed) and reset when an episode ends (the vector envs reset themselves).
+not timed) and reset when an episode ends (the vector envs reset themselves, both in
+Gymnasium's default ``AutoresetMode.NEXT_STEP``: like is compared with like).
 The orbit env is timed twice: with random actions, which burn in three steps of
 four until the tank is empty (the worst case: every burn re-locates the orbit on
 the curves), and coasting (action 0, what a satellite does most of its life).
@@ -111,7 +112,8 @@ def main() -> None:
     print(f"  OrbitRaising-v0, coasting             {n / t_coast:>12,.0f} steps/s  ratio {t_cart / t_coast:.2f}")
 
     cart_vec = CartPoleVectorEnv(num_envs=NUM_ENVS)
-    orbit_vec = gym.make_vec("OrbitRaising-v0", num_envs=NUM_ENVS, vectorization_mode="vector_entry_point")
+    orbit_vec = gym.make_vec("OrbitRaising-v0", num_envs=NUM_ENVS, autoreset_mode=gym.vector.AutoresetMode.NEXT_STEP)
+    assert orbit_vec.metadata["autoreset_mode"] == cart_vec.metadata["autoreset_mode"]
     m = args.vector_steps
     cart_vec_actions = [rng.integers(0, 2, NUM_ENVS) for _ in range(m)]
     orbit_vec_actions = [rng.integers(0, orbit.action_space.n, NUM_ENVS) for _ in range(m)]
@@ -123,7 +125,7 @@ def main() -> None:
         lambda: time_vector(orbit_vec, coast_vec_actions, args.warmup),
     )
     per = m * NUM_ENVS
-    print(f"vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}")
+    print(f"vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}, autoreset NEXT_STEP on both")
     print(f"  CartPoleVectorEnv                     {per / t_cart:>12,.0f} steps/s")
     print(f"  OrbitRaising-v0, random actions       {per / t_orbit:>12,.0f} steps/s  ratio {t_cart / t_orbit:.2f}")
     print(f"  OrbitRaising-v0, coasting             {per / t_coast:>12,.0f} steps/s  ratio {t_cart / t_coast:.2f}")

@@ -29,6 +29,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -39,7 +40,7 @@ from orbit_env.decay.averaged import integrate_averaged
 from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig, OrbitRaisingEnv, register_envs
 from orbit_env.envs import orbit_raising as orbit_raising_module
-from orbit_env.envs.config import DEFAULT_HORIZON_STEPS
+from orbit_env.envs.config import CONFIG_FIELDS, DEFAULT_HORIZON_STEPS, DENSITY_FIELDS, UNCERTAIN_DENSITY
 from orbit_env.envs.task import OBS_HIGH, delta_v_left_m_s
 from orbit_env.envs.vector import OrbitRaisingVectorEnv
 from orbit_env.physics.orbit import perigee_velocity_m_s
@@ -81,7 +82,8 @@ def test_register_envs_is_idempotent_and_uses_string_entry_points():
         spec = gym.spec(env_id)
         assert isinstance(spec.entry_point, str)
         assert isinstance(spec.vector_entry_point, str)
-        assert spec.max_episode_steps == DEFAULT_HORIZON_STEPS == OrbitRaisingConfig().horizon_steps
+        assert spec.max_episode_steps is None  # horizon_steps owns the truncation
+    assert OrbitRaisingConfig().horizon_steps == DEFAULT_HORIZON_STEPS
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
@@ -108,26 +110,86 @@ def test_sb3_check_env_passes_without_warnings(env_id):
 def test_make_vec_gives_the_numpy_batched_env(env_id):
     env = make_vec(env_id, 5)
     assert isinstance(env.unwrapped, OrbitRaisingVectorEnv)
-    assert env.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
+    assert env.metadata["autoreset_mode"] == gym.vector.AutoresetMode.NEXT_STEP  # Gymnasium's default
+    assert isinstance(gym.make_vec(env_id, num_envs=2).unwrapped, OrbitRaisingVectorEnv)  # the default mode
+    for mode in gym.vector.AutoresetMode:
+        assert make_vec(env_id, 2, autoreset_mode=mode).metadata["autoreset_mode"] is mode
+    assert make_vec(env_id, 2, autoreset_mode="SameStep").metadata["autoreset_mode"] is AutoresetMode.SAME_STEP
+    with pytest.raises(ValueError, match=r"autoreset_mode='sometimes' is invalid; allowed: AutoresetMode.NEXT_STEP"):
+        make_vec(env_id, 2, autoreset_mode="sometimes")
     obs, _ = env.reset(seed=0)
     assert obs.shape == (5, 7) and obs.dtype == np.float32
     assert env.observation_space.contains(obs)
 
 
-def test_horizon_must_match_max_episode_steps():
-    config = OrbitRaisingConfig(horizon_steps=10)
-    env = make("OrbitRaising-v0", config=config)  # TimeLimit at 365 steps: a mismatch
-    env.reset(seed=0, options={"perigee_km": 500.0, "apogee_km": 1000.0})
-    for _ in range(10):
-        obs, *_ = env.step(0)
-    assert obs[3] == 1.0
-    with pytest.warns(UserWarning, match="stepped past config.horizon_steps=10"):
-        obs, *_ = env.step(0)
-    assert obs[3] == 1.0  # the clock saturates: the observation stays in its space
-    with pytest.raises(ValueError, match=r"max_episode_steps=365 but config\.horizon_steps=10"):
-        make_vec("OrbitRaising-v0", 2, config=config)
-    make("OrbitRaising-v0", config=config, max_episode_steps=10).reset(seed=0)
-    make_vec("OrbitRaising-v0", 2, config=config, max_episode_steps=10).reset(seed=0)
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"horizon_steps": 10}, {"config": OrbitRaisingConfig(horizon_steps=10)}, {"config": {"horizon_steps": 10}}],
+    ids=["flat", "object", "dict"],
+)
+def test_horizon_steps_alone_sets_the_truncation_and_the_clock(kwargs):
+    start = {"perigee_km": 500.0, "apogee_km": 1000.0}  # outlives the mission
+    env = make("OrbitRaising-v0", **kwargs)
+    env.reset(seed=0, options=start)
+    for k in range(1, 11):
+        obs, _, terminated, truncated, _ = env.step(0)
+        assert obs[3] == pytest.approx(k / 10) and not terminated and truncated == (k == 10)
+    vec = make_vec("OrbitRaising-v0", 2, **kwargs)
+    vec.reset(seed=0, options=start)
+    for k in range(1, 11):
+        obs, _, terminated, truncated, _ = vec.step(np.zeros(2, dtype=np.int64))
+        np.testing.assert_allclose(obs[:, 3], k / 10, rtol=1e-6)
+        assert not terminated.any() and (truncated == (k == 10)).all()
+    with pytest.raises(ValueError, match=r"max_episode_steps=20 but horizon_steps=10; pass horizon_steps=20"):
+        make_vec("OrbitRaising-v0", 2, max_episode_steps=20, **kwargs)
+    make_vec("OrbitRaising-v0", 2, max_episode_steps=10, **kwargs).reset(seed=0)  # the same number is accepted
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_every_config_field_is_a_flat_keyword(env_id):
+    fields = {
+        "drag_coefficient": 2.0,
+        "area_m2": 1.5,
+        "dry_mass_kg": 50.0,
+        "propellant_mass_kg": 5.0,
+        "isp_s": 230.0,
+        "burn_sizes_m_s": (0.0, 20.0),
+        "max_burn_m_s": 50.0,
+        "revolutions_per_step": 8.0,
+        "horizon_steps": 50,
+        "propellant_cost_per_m_s": 0.2,
+        "start_perigee_km": (200.0, 300.0),
+        "start_apogee_max_km": 900.0,
+    }
+    density = {"scale_range": (0.5, 2.0), "cycle_amplitude": 0.1, "cycle_period_days": 1000.0}
+    assert set(fields) == set(CONFIG_FIELDS) and set(density) == set(DENSITY_FIELDS)
+    for env in (make(env_id, **fields, **density), make_vec(env_id, 3, **fields, **density)):
+        base = env.unwrapped
+        for name, value in fields.items():
+            assert getattr(base.config, name) == value, name
+        for name, value in density.items():
+            assert getattr(base.density, name) == value, name
+    # Lists, as TOML and YAML give them, and flat keywords over a config object.
+    env = make(env_id, config=OrbitRaisingConfig(area_m2=3.0), burn_sizes_m_s=[0.0, 5.0], horizon_steps=7)
+    assert env.unwrapped.config.burn_sizes_m_s == (0.0, 5.0) and env.unwrapped.config.area_m2 == 3.0
+    assert env.unwrapped.config.horizon_steps == 7
+    # The registered variant's density is kept where a keyword does not replace it.
+    expected = UNCERTAIN_DENSITY.cycle_amplitude if env_id == "OrbitRaisingUncertain-v0" else 0.0
+    assert make(env_id, scale_range=(1.0, 3.0)).unwrapped.density.cycle_amplitude == expected
+
+
+@pytest.mark.parametrize("maker", [make, lambda env_id, **kw: make_vec(env_id, 2, **kw)], ids=["make", "make_vec"])
+def test_unknown_keywords_are_value_errors_listing_the_valid_ones(maker):
+    with pytest.raises(ValueError, match=r"unknown keyword 'horizn_steps'; valid keywords: .*horizon_steps"):
+        maker("OrbitRaising-v0", horizn_steps=10)
+    with pytest.raises(ValueError, match=r"config has the unknown key 'are_m2'; valid keys: .*area_m2"):
+        maker("OrbitRaising-v0", config={"are_m2": 2.0})
+    with pytest.raises(ValueError, match=r"density has the unknown key 'scale'; valid keys: scale_range"):
+        maker("OrbitRaising-v0", density={"scale": 2.0})
+    with pytest.raises(ValueError, match=r"horizon_steps=0 is out of range"):
+        maker("OrbitRaising-v0", horizon_steps=0)
+    with pytest.raises(ValueError, match=r"config=3 is invalid"):
+        maker("OrbitRaising-v0", config=3)
 
 
 def test_docstring_examples_run():
@@ -276,10 +338,9 @@ def lock_step_starts(n: int, seed: int) -> list[dict[str, float]]:
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_single_and_vector_envs_step_in_lock_step(env_id):
     n = 7
-    config = OrbitRaisingConfig(horizon_steps=SHORT)
     starts = lock_step_starts(n, seed=4)
-    vec = make_vec(env_id, n, config=config, max_episode_steps=SHORT)
-    singles = [make(env_id, config=config, max_episode_steps=SHORT) for _ in range(n)]
+    vec = make_vec(env_id, n, horizon_steps=SHORT)  # NEXT_STEP: the ending step shows the last observation
+    singles = [make(env_id, horizon_steps=SHORT) for _ in range(n)]
     options = {key: np.array([s[key] for s in starts]) for key in starts[0]}
     obs_v, _ = vec.reset(seed=1, options=options)
     for i, single in enumerate(singles):
@@ -289,23 +350,105 @@ def test_single_and_vector_envs_step_in_lock_step(env_id):
     active = np.ones(n, dtype=bool)
     ends = set()
     for action in actions:
-        obs_v, reward_v, terminated_v, truncated_v, info = vec.step(action)
+        obs_v, reward_v, terminated_v, truncated_v, _ = vec.step(action)
         state_v = vec.unwrapped.state
         for i in np.flatnonzero(active):
             obs_s, reward_s, terminated_s, truncated_s, _ = singles[i].step(action[i])
             assert (terminated_v[i], truncated_v[i]) == (terminated_s, truncated_s)
             np.testing.assert_allclose(reward_v[i], reward_s, rtol=1e-9, atol=1e-12)
+            np.testing.assert_allclose(obs_v[i], obs_s, rtol=1e-6, atol=1e-7)
+            state_s = singles[i].unwrapped.state
+            for key, value in state_s.items():
+                np.testing.assert_allclose(state_v[key][i], value, rtol=1e-9, atol=1e-12, err_msg=key)
             if terminated_s or truncated_s:
-                np.testing.assert_allclose(info["final_obs"][i], obs_s, rtol=1e-6, atol=1e-7)
                 active[i] = False
                 ends.add("terminated" if terminated_s else "truncated")
-            else:
-                np.testing.assert_allclose(obs_v[i], obs_s, rtol=1e-6, atol=1e-7)
-                state_s = singles[i].unwrapped.state
-                for key, value in state_s.items():
-                    np.testing.assert_allclose(state_v[key][i], value, rtol=1e-9, atol=1e-12, err_msg=key)
     assert not active.any(), "every episode ends at the horizon at the latest"
     assert ends == {"terminated", "truncated"}, "the test must see both ways an episode ends"
+
+
+#: One start orbit for every episode (a 240 km circular orbit), so that the automatic resets of
+#: the batch (one random stream) and of SyncVectorEnv (one per env) start the same missions;
+#: under random actions some re-enter within the horizon and some reach it.
+FIXED_START = {"start_perigee_km": (240.0, 240.0), "start_apogee_max_km": 240.0, "horizon_steps": SHORT}
+
+
+def assert_infos_match(info_v: dict, info_s: dict, key: str) -> None:
+    """The batched info ``key`` and its mask agree; values only where the mask is set."""
+    mask_s = info_s.get(f"_{key}", np.zeros(len(info_v[f"_{key}"]), dtype=bool))
+    np.testing.assert_array_equal(info_v[f"_{key}"], mask_s, err_msg=f"_{key}")
+    if mask_s.any():
+        np.testing.assert_allclose(info_v[key][mask_s], info_s[key][mask_s], rtol=1e-9, atol=1e-12, err_msg=key)
+
+
+@pytest.mark.parametrize("mode", list(AutoresetMode), ids=lambda m: m.name)
+@pytest.mark.parametrize("env_id", ["OrbitRaising-v0", "OrbitRaisingContinuous-v0"])
+def test_vector_env_steps_in_lock_step_with_sync_vector_env(env_id, mode):
+    n = 6
+    vec = make_vec(env_id, n, autoreset_mode=mode, **FIXED_START)
+    sync = SyncVectorEnv([lambda: make(env_id, **FIXED_START) for _ in range(n)], autoreset_mode=mode)
+    assert vec.metadata["autoreset_mode"] is sync.metadata["autoreset_mode"] is mode
+    obs_v, _ = vec.reset(seed=1)
+    obs_s, _ = sync.reset(seed=1)
+    np.testing.assert_allclose(obs_v, obs_s, rtol=1e-6, atol=1e-7)
+    actions = random_actions(vec.action_space, 3 * SHORT, seed=9)
+    seen = {"terminated": 0, "truncated": 0, "restarted": 0}
+    for action in actions:
+        obs_v, reward_v, terminated_v, truncated_v, info_v = vec.step(action)
+        obs_s, reward_s, terminated_s, truncated_s, info_s = sync.step(action)
+        np.testing.assert_allclose(obs_v, obs_s, rtol=1e-6, atol=1e-7)
+        np.testing.assert_allclose(reward_v, reward_s, rtol=1e-9, atol=1e-12)
+        np.testing.assert_array_equal(terminated_v, terminated_s)
+        np.testing.assert_array_equal(truncated_v, truncated_s)
+        assert_infos_match(info_v, info_s, "burn_m_s")
+        done = terminated_s | truncated_s
+        seen["terminated"] += int(terminated_s.sum())
+        seen["truncated"] += int((truncated_s & ~terminated_s).sum())
+        if mode is AutoresetMode.SAME_STEP:
+            assert ("final_obs" in info_v) == done.any() == ("final_obs" in info_s)
+            if done.any():
+                np.testing.assert_array_equal(info_v["_final_obs"], info_s["_final_obs"])
+                np.testing.assert_array_equal(info_v["_final_info"], info_s["_final_info"])
+                for i in np.flatnonzero(done):
+                    np.testing.assert_allclose(info_v["final_obs"][i], info_s["final_obs"][i], rtol=1e-6, atol=1e-7)
+                assert_infos_match(info_v["final_info"], info_s["final_info"], "burn_m_s")
+                assert np.all(obs_v[done, 3] == 0.0)  # the new mission's first observation
+                seen["restarted"] += int(done.sum())
+        else:
+            assert "final_obs" not in info_v
+        if mode is AutoresetMode.NEXT_STEP:
+            seen["restarted"] += int((~info_s.get("_burn_m_s", np.zeros(n, dtype=bool))).sum())
+        if mode is AutoresetMode.DISABLED and done.any():
+            with pytest.raises(RuntimeError, match="autoreset_mode is DISABLED"):
+                vec.step(action)
+            obs_v, _ = vec.reset(options={"reset_mask": done})
+            obs_s, _ = sync.reset(options={"reset_mask": done})
+            np.testing.assert_allclose(obs_v, obs_s, rtol=1e-6, atol=1e-7)
+            seen["restarted"] += int(done.sum())
+    assert min(seen.values()) > 0, f"the test must see both ends and a restart: {seen}"
+
+
+@pytest.mark.parametrize(
+    "wrapper",
+    [
+        gym.wrappers.vector.NormalizeObservation,
+        gym.wrappers.vector.FlattenObservation,
+        lambda env: gym.wrappers.vector.TransformObservation(env, lambda obs: 2.0 * obs),
+        gym.wrappers.vector.NormalizeReward,
+        gym.wrappers.vector.RecordEpisodeStatistics,
+    ],
+    ids=["NormalizeObservation", "FlattenObservation", "TransformObservation", "NormalizeReward", "Statistics"],
+)
+def test_gymnasiums_vector_wrappers_run_on_the_default_mode(wrapper):
+    env = wrapper(make_vec("OrbitRaising-v0", 8, horizon_steps=SHORT))
+    env.reset(seed=0)
+    episodes = 0
+    for _ in range(2 * SHORT + 2):
+        obs, reward, *_, info = env.step(env.action_space.sample())
+        assert obs.shape == (8, 7) and np.isfinite(obs).all() and np.isfinite(reward).all()
+        episodes += int(info.get("_episode", np.zeros(8, dtype=bool)).sum())
+    if isinstance(env, gym.wrappers.vector.RecordEpisodeStatistics):
+        assert episodes >= 8  # every satellite ended an episode at least once
 
 
 # --------------------------------------------------------------------------------------

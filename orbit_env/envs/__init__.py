@@ -7,7 +7,7 @@
 | ``OrbitRaisingUncertain-v0``  | Discrete: burn sizes   | scale drawn per episode, hidden, drifting |
 
 Each has a single environment (``gymnasium.make``) and a numpy-batched vector
-environment (``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")``);
+environment (``gymnasium.make_vec(id, num_envs=N)``, autoreset ``NEXT_STEP`` by default);
 :mod:`orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
 is the docstring of :class:`OrbitRaisingEnv`.
 """
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import gymnasium
 
-from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
+from orbit_env.envs.config import UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
 from orbit_env.envs.orbit_raising import OrbitRaisingEnv
 
 __all__ = ["ENV_IDS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv", "register_envs"]
@@ -36,8 +36,9 @@ ENV_IDS = tuple(_VARIANTS)
 def register_envs() -> None:
     """Register the orbit-raising environments with Gymnasium (safe to call twice).
 
-    Truncation of the single environment is the registered ``max_episode_steps``
-    (``DEFAULT_HORIZON_STEPS``); the vector environment owns its own.
+    No ``max_episode_steps``: both environments truncate themselves after
+    ``horizon_steps`` (a flat keyword of ``gymnasium.make``), the one owner of the
+    truncation and of the observed clock.
     """
     for env_id, kwargs in _VARIANTS.items():
         if env_id in gymnasium.registry:
@@ -46,6 +47,5 @@ def register_envs() -> None:
             id=env_id,
             entry_point=_ENTRY_POINT,
             vector_entry_point=_VECTOR_ENTRY_POINT,
-            max_episode_steps=DEFAULT_HORIZON_STEPS,
             kwargs=dict(kwargs),
         )

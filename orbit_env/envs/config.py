@@ -10,7 +10,8 @@ are properties. SI units except where a name says otherwise (``_km``, ``_days``,
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -23,7 +24,7 @@ from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
 #: Largest delta-v a satellite may carry [m/s]. More is beyond escape from low orbit,
 #: never an orbit-raising budget; the bound keeps the observation space bounded.
 MAX_DV_CAPACITY_M_S = 3000.0
-#: Default mission length in steps; also the registered ``max_episode_steps``.
+#: Default mission length in steps (``OrbitRaisingConfig.horizon_steps``): the truncation and the clock.
 DEFAULT_HORIZON_STEPS = 365
 
 
@@ -103,8 +104,8 @@ class OrbitRaisingConfig:
             one of the class of the paper's 78 m/s manoeuvre (+350 km).
         max_burn_m_s: Delta-v of the continuous action at +1 [m/s] (100).
         revolutions_per_step: K, revolutions coasted per step (16: about one day).
-        horizon_steps: Mission length in steps (365: about a year); the
-            registered ``max_episode_steps``. Change both together.
+        horizon_steps: Mission length in steps (365: about a year). It alone sets
+            the truncation and the observation's mission clock.
         propellant_cost_per_m_s: Reward cost of a burn [days per m/s] (0.4: the
             whole tank is worth 120 days of mission, so burning without need costs,
             and a burn that saves a mission pays many times over).
@@ -209,3 +210,59 @@ def validate_satellite(
             f"the satellite carries {np.broadcast_to(capacity, bad.shape)[bad].flat[0]:.0f} m/s of delta-v "
             f"(isp_s, propellant_mass_kg, dry_mass_kg); allowed: up to {MAX_DV_CAPACITY_M_S:g} m/s"
         )
+
+
+#: The flat keywords of ``gymnasium.make`` and ``gymnasium.make_vec``: every field of
+#: :class:`OrbitRaisingConfig` and of :class:`DensityConfig` (their names do not overlap).
+CONFIG_FIELDS = tuple(f.name for f in fields(OrbitRaisingConfig))
+DENSITY_FIELDS = tuple(f.name for f in fields(DensityConfig))
+
+
+def _from(cls: type, value: Any, name: str, overrides: Mapping[str, Any]) -> Any:
+    """``value`` (None, an instance of ``cls`` or a mapping of its fields) with ``overrides`` applied."""
+    valid = [f.name for f in fields(cls)]
+    if value is None:
+        base: dict[str, Any] = {}
+    elif isinstance(value, cls):
+        base = {key: getattr(value, key) for key in valid}
+    elif isinstance(value, Mapping):
+        unknown = [key for key in value if key not in valid]
+        if unknown:
+            raise ValueError(f"{name} has the unknown key {unknown[0]!r}; valid keys: {', '.join(valid)}")
+        base = dict(value)
+    else:
+        raise ValueError(f"{name}={value!r} is invalid; allowed: a {cls.__name__}, a dict of its fields, or None")
+    if value is not None and not overrides and isinstance(value, cls):
+        return value
+    return cls(**{**base, **overrides})
+
+
+def resolve_task_arguments(
+    config: Any = None, density: Any = None, keywords: Mapping[str, Any] | None = None, *, env_keywords: tuple = ()
+) -> tuple[OrbitRaisingConfig, DensityConfig]:
+    """The config and density of an environment's arguments, Gymnasium's way.
+
+    ``config`` and ``density`` may be None (the defaults), the dataclasses or dicts of
+    their fields (as read from a TOML or YAML file); each flat keyword (``horizon_steps=100``,
+    ``scale_range=(0.1, 10)``) then replaces that field.
+
+    Args:
+        config: An :class:`OrbitRaisingConfig`, a dict of its fields, or None.
+        density: A :class:`DensityConfig`, a dict of its fields, or None.
+        keywords: Flat keywords, each a field of either.
+        env_keywords: The environment's other keywords, listed in the error message.
+
+    Raises:
+        ValueError: an unknown keyword or key (named, with the valid ones), or a bad value.
+    """
+    keywords = dict(keywords or {})
+    unknown = [key for key in keywords if key not in CONFIG_FIELDS and key not in DENSITY_FIELDS]
+    if unknown:
+        valid = sorted((*env_keywords, *CONFIG_FIELDS, *DENSITY_FIELDS))
+        raise ValueError(f"unknown keyword {unknown[0]!r}; valid keywords: {', '.join(valid)}")
+    config_overrides = {key: value for key, value in keywords.items() if key in CONFIG_FIELDS}
+    density_overrides = {key: value for key, value in keywords.items() if key in DENSITY_FIELDS}
+    return (
+        _from(OrbitRaisingConfig, config, "config", config_overrides),
+        _from(DensityConfig, density, "density", density_overrides),
+    )

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
-from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, DensityConfig, OrbitRaisingConfig
+from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, DensityConfig, OrbitRaisingConfig, resolve_task_arguments
 from orbit_env.envs.task import Task, TaskState, TaskView
 
 __all__ = ["DEFAULT_HORIZON_STEPS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv"]
@@ -90,20 +90,25 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ## Episode End
 
     Termination: re-entry, perigee at 100 km (the paper's end of integration).
-    Truncation: after ``horizon_steps`` steps (365), owned by the registered
-    ``max_episode_steps`` (Gymnasium's ``TimeLimit``). For another horizon pass
-    both: ``gymnasium.make(id, config=cfg, max_episode_steps=cfg.horizon_steps)``
-    (the vector environment refuses a mismatch; the single one cannot see its
-    ``TimeLimit``, so it warns once stepped past ``horizon_steps`` and holds
-    the clock at 1).
+    Truncation: after ``horizon_steps`` steps (365), by the environment itself:
+    ``horizon_steps`` alone sets the truncation and the mission clock, so the ids
+    are registered without ``max_episode_steps``. (A ``max_episode_steps`` given to
+    ``gymnasium.make`` adds Gymnasium's ``TimeLimit`` outside the environment,
+    which cannot see it: pass ``horizon_steps`` instead.)
 
     ## Arguments
 
-    ``gymnasium.make("OrbitRaising-v0", config=OrbitRaisingConfig(...),
-    continuous=False, density=DensityConfig(...), render_mode=None)``; the same
-    keywords for ``gymnasium.make_vec(id, num_envs=N,
-    vectorization_mode="vector_entry_point")``, the numpy-batched version
-    (:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`).
+    Every field of :class:`OrbitRaisingConfig` and :class:`DensityConfig` is a
+    flat keyword, as LunarLander's ``gravity=``:
+    ``gymnasium.make("OrbitRaising-v0", horizon_steps=100, area_m2=2.0)``,
+    ``gymnasium.make("OrbitRaisingUncertain-v0", scale_range=(0.5, 2.0))``. A
+    config object or a dict of its fields works too (``config=OrbitRaisingConfig(...)``,
+    ``config={"horizon_steps": 100}``, ``density=DensityConfig(...)``); flat keywords
+    then replace single fields. An unknown keyword is a ``ValueError`` that names it
+    and lists the valid ones. Besides: ``continuous=False`` and ``render_mode=None``.
+    The same keywords for ``gymnasium.make_vec(id, num_envs=N)``, the numpy-batched
+    version (:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`), which also takes
+    ``autoreset_mode``.
     ``render_mode``: "human" and "rgb_array" draw the (apogee, perigee) plane of
     the paper's Fig. 2 with the track and the burns (needs ``orbit-env[plot]``);
     "ansi" returns one line of text.
@@ -151,12 +156,16 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     def __init__(
         self,
-        config: OrbitRaisingConfig | None = None,
+        config: OrbitRaisingConfig | dict[str, Any] | None = None,
         *,
         continuous: bool = False,
-        density: DensityConfig | None = None,
+        density: DensityConfig | dict[str, Any] | None = None,
         render_mode: str | None = None,
+        **keywords: Any,
     ) -> None:
+        config, density = resolve_task_arguments(
+            config, density, keywords, env_keywords=("config", "continuous", "density", "render_mode")
+        )
         self.task = Task.of(config, density, continuous)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
@@ -222,12 +231,6 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         task = self.task
         requested = task.requested_dv(action)
         result = task_model.step(task, state, requested)
-        if state.steps == task.config.horizon_steps + 1:
-            gym.logger.warn(
-                f"stepped past config.horizon_steps={task.config.horizon_steps}: the mission clock stays at 1. "
-                "Truncation belongs to gymnasium.make's TimeLimit; for another horizon pass "
-                "config=cfg and max_episode_steps=cfg.horizon_steps together."
-            )
         if self.render_mode is not None:
             if result.burn_m_s > 0.0:
                 # The orbit the burn made, before the coast: the heights less the coast's drops.
@@ -238,12 +241,12 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
             self._track.append((state.perigee_m, state.apogee_m, 0.0))
             if self.render_mode == "human":
                 self.render()
-        # Truncation is the registered TimeLimit's (max_episode_steps), so the env itself never truncates.
+        # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         return (
             task_model.observe(task, state),
             result.reward,
             bool(result.terminated),
-            False,
+            bool(result.truncated),
             {"burn_m_s": result.burn_m_s},
         )
 

@@ -2,9 +2,10 @@
 
 SB3 trains on its own ``VecEnv`` interface; :class:`SB3VecEnv` presents a Gymnasium
 vector environment that resets finished episodes in the same step
-(``AutoresetMode.SAME_STEP``, as :class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`)
-through it: one numpy step for all satellites instead of ``DummyVecEnv``'s Python
-loop over single environments. Needs ``pip install 'orbit-env[train]'``.
+(``AutoresetMode.SAME_STEP``, which :func:`make_sb3_vec_env` asks of
+:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`) through it: one numpy step
+for all satellites instead of ``DummyVecEnv``'s Python loop over single environments.
+Needs ``pip install 'orbit-env[train]'``.
 
 >>> from orbit_env.envs.sb3 import make_sb3_vec_env
 >>> venv = make_sb3_vec_env("OrbitRaising-v0", num_envs=8, seed=0)
@@ -53,7 +54,7 @@ class SB3VecEnv(VecEnv):
         if mode != AutoresetMode.SAME_STEP:
             raise ValueError(
                 f"env has autoreset_mode={mode!r}; SB3VecEnv needs AutoresetMode.SAME_STEP "
-                "(e.g. gymnasium.make_vec(..., vectorization_mode='vector_entry_point') of an orbit_env id)"
+                "(gymnasium.make_vec(id, num_envs, autoreset_mode=AutoresetMode.SAME_STEP) of an orbit_env id)"
             )
         self.env = env
         self.render_mode = None
@@ -141,7 +142,13 @@ def make_sb3_vec_env(
     from orbit_env.envs import register_envs
 
     register_envs()
-    env = gymnasium.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kwargs)
+    env = gymnasium.make_vec(
+        env_id,
+        num_envs=num_envs,
+        vectorization_mode="vector_entry_point",
+        autoreset_mode=AutoresetMode.SAME_STEP,  # SB3's convention: the next episode's first observation
+        **kwargs,
+    )
     venv = SB3VecEnv(env)
     if seed is not None:
         venv.seed(seed)

@@ -3,10 +3,19 @@
 The same functions of :mod:`orbit_env.envs.task` as the single environment, called
 on a :class:`~orbit_env.envs.task.BatchState` of shape (num_envs,): one call of the
 universal curves moves every satellite. The vector environment owns truncation
-(``horizon_steps``) and resets finished satellites in the same step
-(``AutoresetMode.SAME_STEP``): the step returns the first observation of the new
-episode, and ``info["final_obs"]`` the last one of the old (the convention of
-Stable-Baselines3, see :mod:`orbit_env.envs.sb3`).
+(``horizon_steps``) and restarts finished satellites as Gymnasium 1.x's
+``autoreset_mode`` says:
+
+* ``AutoresetMode.NEXT_STEP`` (default, as ``SyncVectorEnv`` and ``CartPoleVectorEnv``):
+  the step that ends an episode returns its last observation; the next step ignores
+  that satellite's action and returns the first observation of a new episode, with
+  reward 0, not terminated, not truncated, and no ``info["burn_m_s"]`` there.
+* ``AutoresetMode.SAME_STEP``: the step that ends an episode returns the first
+  observation of the new one; ``info["final_obs"]`` and ``info["final_info"]`` hold
+  the last observation and info of the old (the convention of Stable-Baselines3,
+  see :mod:`orbit_env.envs.sb3`).
+* ``AutoresetMode.DISABLED``: no restarts; reset finished satellites with
+  ``reset(options={"reset_mask": mask})`` before stepping them again.
 """
 
 from __future__ import annotations
@@ -19,10 +28,13 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
-from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
+from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig, resolve_task_arguments
 from orbit_env.envs.task import BatchState, Task, TaskView
 
 FloatArray = NDArray[np.float64]
+
+#: The keywords of the vector environment besides the config's and the density's fields.
+_ENV_KEYWORDS = ("num_envs", "config", "continuous", "density", "max_episode_steps", "render_mode", "autoreset_mode")
 
 
 class OrbitRaisingVectorEnv(TaskView, VectorEnv):
@@ -32,9 +44,8 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     :class:`orbit_env.envs.orbit_raising.OrbitRaisingEnv` (read its docstring),
     batched: observations (num_envs, 7) float32, rewards float64, actions of shape
     (num_envs,) (discrete) or (num_envs, 1) (continuous). Truncation after
-    ``config.horizon_steps`` steps. Finished missions restart in the same step
-    (``metadata["autoreset_mode"]`` is ``SAME_STEP``); their last observation is
-    in ``info["final_obs"]`` (masked by ``info["_final_obs"]``).
+    ``config.horizon_steps`` steps. Finished missions restart as ``autoreset_mode``
+    says (see the module; ``metadata["autoreset_mode"]`` tells which).
 
     ``reset(options=...)`` takes the single environment's options, each a number
     or an array of shape (num_envs,); they pin only that reset, not the automatic
@@ -46,33 +57,49 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         config: Satellite and task (default ``OrbitRaisingConfig()``).
         continuous: Continuous burn size instead of the discrete burns.
         density: Density knowledge (default: the paper's atmosphere, known).
-        max_episode_steps: Passed by ``gymnasium.make_vec`` from the registration;
-            must equal ``config.horizon_steps`` (the observation's clock runs on it).
+        max_episode_steps: If given, must equal ``config.horizon_steps``, which
+            alone sets the truncation and the observation's clock.
         render_mode: Only None: render a single environment instead.
+        autoreset_mode: ``AutoresetMode`` (or its value, e.g. ``"SameStep"``);
+            default ``NEXT_STEP``.
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": [], "autoreset_mode": AutoresetMode.SAME_STEP}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(
         self,
         num_envs: int = 1,
-        config: OrbitRaisingConfig | None = None,
+        config: OrbitRaisingConfig | dict[str, Any] | None = None,
         *,
         continuous: bool = False,
-        density: DensityConfig | None = None,
+        density: DensityConfig | dict[str, Any] | None = None,
         max_episode_steps: int | None = None,
         render_mode: str | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        **keywords: Any,
     ) -> None:
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
             raise ValueError(f"num_envs={num_envs!r} is invalid; allowed: an integer >= 1")
+        config, density = resolve_task_arguments(
+            config,
+            density,
+            keywords,
+            env_keywords=_ENV_KEYWORDS,
+        )
         self.task = Task.of(config, density, continuous)
         if max_episode_steps is not None and max_episode_steps != self.config.horizon_steps:
             raise ValueError(
-                f"max_episode_steps={max_episode_steps} but config.horizon_steps={self.config.horizon_steps}; "
-                "pass max_episode_steps=config.horizon_steps to gymnasium.make_vec"
+                f"max_episode_steps={max_episode_steps} but horizon_steps={self.config.horizon_steps}; "
+                f"pass horizon_steps={max_episode_steps}: it alone sets the truncation and the clock"
             )
         if render_mode is not None:
             raise ValueError(f"render_mode={render_mode!r} is invalid; the vector environment does not render")
+        try:
+            self.autoreset_mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            allowed = ", ".join(f"AutoresetMode.{m.name} ({m.value!r})" for m in AutoresetMode)
+            raise ValueError(f"autoreset_mode={autoreset_mode!r} is invalid; allowed: {allowed}") from None
+        self.metadata = {**type(self).metadata, "autoreset_mode": self.autoreset_mode}
         self.num_envs = int(num_envs)
         self.render_mode = None
         self.single_observation_space = self.task.observation_space
@@ -87,6 +114,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         self._last_obs = np.zeros((self.num_envs, 7), dtype=np.float32)  # for reset_mask
         self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
         self._everyone_mask.flags.writeable = False
+        self._finished = np.zeros(0, dtype=np.intp)  # ended in the last step (NEXT_STEP, DISABLED)
 
     @property
     def state(self) -> dict[str, FloatArray]:
@@ -132,6 +160,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             obs[idx] = task_model.observe(self.task, fresh)
         self._has_state = True
         self._last_obs = obs
+        self._finished = np.setdiff1d(self._finished, idx, assume_unique=True) if mask is not None else idx[:0]
         return obs, {}
 
     def _masked(self, mask: Any) -> NDArray[np.intp]:
@@ -154,19 +183,41 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             raise RuntimeError("call reset() before step()")
         task = self.task
         requested = task.requested_dvs(actions, self.num_envs)
+        restart = self._finished
+        if restart.size:
+            if self.autoreset_mode is AutoresetMode.DISABLED:
+                raise RuntimeError(
+                    f"sub-environments {restart.tolist()} have finished and autoreset_mode is DISABLED; "
+                    "restart them with reset(options={'reset_mask': mask}) before stepping them"
+                )
+            requested[restart] = 0.0  # NEXT_STEP: the action of a finished satellite is ignored
         reward, terminated, truncated, dv = task_model.step(task, self._state, requested)
         obs = task_model.observe(task, self._state)
         # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._everyone_mask}
+        if restart.size:
+            # NEXT_STEP: the satellites that ended in the last step start anew instead.
+            obs[restart] = self._restart(restart)
+            reward[restart] = 0.0
+            terminated[restart] = False
+            truncated[restart] = False
+            dv[restart] = 0.0
+            stepped = np.ones(self.num_envs, dtype=np.bool_)
+            stepped[restart] = False
+            infos["_burn_m_s"] = stepped
         done = terminated | truncated
         finished = np.flatnonzero(done)
-        if finished.size:
+        if self.autoreset_mode is not AutoresetMode.SAME_STEP:
+            self._finished = finished
+        elif finished.size:
             final_obs = np.empty(self.num_envs, dtype=object)
             final_obs[finished] = np.fromiter(obs[finished], dtype=object, count=finished.size)  # rows, as arrays
             infos["final_obs"] = final_obs
             infos["_final_obs"] = done
-            infos["final_info"] = {}
+            # As SyncVectorEnv: the old episode's info moves to final_info, the new one's (empty) stays.
+            infos["final_info"] = {"burn_m_s": dv, "_burn_m_s": done}
             infos["_final_info"] = done
+            infos["_burn_m_s"] = ~done
             obs[finished] = self._restart(finished)
         self._last_obs = obs
         return obs, reward, terminated, truncated, infos
