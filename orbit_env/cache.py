@@ -4,8 +4,8 @@ Each entry is one compressed ``.npz`` file of named arrays in the user's cache f
 (``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux),
 under a name made from a hash of everything that shapes the table: its kind, a
 description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
-the source of the module that builds it, the package's version and
-:data:`FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
+the package's source code (every module: the physics under a table changes
+with any of them), its version and :data:`FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
 never read (old files stay until the cache folder is cleared).
 
 Writes are atomic: a table is written to a temporary file in the same folder and
@@ -84,30 +84,40 @@ def describe(value: Any) -> str | None:
     return None
 
 
-@functools.lru_cache(maxsize=32)
-def _source_digest(builder_file: str) -> str:
-    return hashlib.sha256(Path(builder_file).read_bytes()).hexdigest()
+@functools.cache
+def _source_digest() -> str:
+    """A hash of the package's Python source (read once per process: a few milliseconds)."""
+    import importlib.util
+
+    roots = [Path(__file__).parent]
+    agents = importlib.util.find_spec("orbit_env.agents")
+    if agents is not None and agents.submodule_search_locations:
+        roots += [Path(p) for p in agents.submodule_search_locations]
+    digest = hashlib.sha256()
+    for root in roots:
+        for path in sorted(root.rglob("*.py")):
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
 
 
-def _path(kind: str, description: str, builder_file: str) -> Path | None:
+def _path(kind: str, description: str) -> Path | None:
     folder = cache_dir()
     if folder is None:
         return None
     from orbit_env import __version__
 
-    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{_source_digest(builder_file)}|{description}"
+    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{_source_digest()}|{description}"
     return folder / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
 
 
-def load(kind: str, description: str | None, builder_file: str) -> dict[str, np.ndarray] | None:
+def load(kind: str, description: str | None) -> dict[str, np.ndarray] | None:
     """The cached arrays of a table, or None (not cached, no description, cache disabled or unreadable).
 
     Args:
         kind: The kind of table (``"curves"``, ``"msis"``, ``"dp"``): the file's prefix.
         description: What shapes the table (:func:`describe`); None: not cacheable.
-        builder_file: The ``__file__`` of the module that builds the table (its source is in the key).
     """
-    path = None if description is None else _path(kind, description, builder_file)
+    path = None if description is None else _path(kind, description)
     if path is None or not path.is_file():
         return None
     try:
@@ -117,9 +127,9 @@ def load(kind: str, description: str | None, builder_file: str) -> dict[str, np.
         return None  # unreadable (truncated by a crash, another format): built again and rewritten
 
 
-def store(kind: str, description: str | None, builder_file: str, arrays: dict[str, np.ndarray]) -> None:
+def store(kind: str, description: str | None, arrays: dict[str, np.ndarray]) -> None:
     """Write a table's arrays to the cache, atomically; a cache that cannot be written is passed over."""
-    path = None if description is None else _path(kind, description, builder_file)
+    path = None if description is None else _path(kind, description)
     if path is None:
         return
     try:

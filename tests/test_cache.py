@@ -43,9 +43,9 @@ def test_a_damaged_file_is_built_again(folder):
     built = UniversalCurves(model)
     (path,) = folder.glob("curves-*.npz")
     path.write_bytes(b"not a zip file")
+    assert cache.load("curves", cache.describe(model)) is None  # unreadable: as if not cached
     again = UniversalCurves(model)
     np.testing.assert_array_equal(again._table_b.cells, built._table_b.cells)
-    assert cache.load("curves", cache.describe(model), cache.__file__) is None  # another builder: another key
     with np.load(path) as data:  # rewritten whole
         assert set(data.files) == {"a", "b"}
 

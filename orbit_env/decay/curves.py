@@ -283,10 +283,10 @@ class UniversalCurves:
         self.labels = np.arange(_LOWEST_LABEL, np.log(_eccentricity(REENTRY_ALTITUDE_M, _HA_TOP_M)), _LABEL_SPACING)
         # Half a second to integrate: kept on disk per model (orbit_env.cache).
         description = cache.describe(model)
-        tables = cache.load("curves", description, __file__)
+        tables = cache.load("curves", description)
         if tables is None:
             tables = self._build()
-            cache.store("curves", description, __file__, tables)
+            cache.store("curves", description, tables)
         label0 = float(self.labels[0])
         self._table_a = _Grid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
         self._table_b = _Grid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)

@@ -235,10 +235,10 @@ def mean_density_over_days_kg_m3(
 def _cached_log_density_table(*conditions: float | None) -> FloatArray:
     """:func:`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""
     description = cache.describe(conditions)
-    table = cache.load("msis", description, __file__)
+    table = cache.load("msis", description)
     if table is None:
         table = {"log_density": _log_density_table(*conditions)}
-        cache.store("msis", description, __file__, table)
+        cache.store("msis", description, table)
     return table["log_density"]
 
 
