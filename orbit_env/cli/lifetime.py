@@ -12,8 +12,16 @@ import json
 import time
 from typing import Any
 
-from orbit_env.analysis.lifetime import METHODS, Satellite, check_rule, lifetime, make_satellite
+from orbit_env.analysis.lifetime import (
+    METHODS,
+    PAPER_DRAG_COEFFICIENT,
+    Satellite,
+    check_rule,
+    lifetime,
+    make_satellite,
+)
 from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
+from orbit_env.cli import orbit_inputs
 from orbit_env.cli.common import flag, given, number, write_csv
 from orbit_env.decay.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
 from orbit_env.physics.atmosphere import ExponentialAtmosphere
@@ -80,18 +88,22 @@ def _scenario(args: argparse.Namespace) -> Scenario:
 
 
 def _satellite(args: argparse.Namespace) -> Satellite:
-    return make_satellite(args.cx, args.mass, args.area, args.mass_per_area)
+    cx = PAPER_DRAG_COEFFICIENT if args.cx is None else args.cx
+    return make_satellite(cx, args.mass, args.area, args.mass_per_area)
 
 
 def _cmd_lifetime(args: argparse.Namespace) -> int:
-    satellite = _satellite(args)
+    orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
+    satellite, drag_source, drag_report = orbit_inputs.satellite_from_args(args, orbit, scenario)
     if args.batch:
         return _lifetime_batch(args, satellite, scenario)
     if args.out:
         raise ValueError("--out goes with --batch (a single lifetime prints; --trajectory writes its history)")
-    if args.perigee is None or args.apogee is None:
-        raise ValueError("give --perigee and --apogee (or --batch CSV)")
+    if orbit.perigee_km is None or orbit.apogee_km is None:
+        raise ValueError("give --perigee and --apogee, --semi-major-axis-km and --eccentricity, --tle, or --batch")
+    perigee_km, apogee_km = orbit.sphere_heights_km
+    offset = orbit.offset_km
     # Default method: the averaged ODE (the reference) for a fixed atmosphere; for activity that changes
     # in time, the time-stepped curves (the averaged reference then rebuilds NRLMSIS every day: minutes).
     method = args.method or ("curves" if scenario.time_varying else "averaged")
@@ -104,9 +116,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if scenario.atmosphere == "paper":
         options.update(rho100_kg_m3=args.rho100, density_scale=args.density_scale)
     elif scenario.atmosphere == "exponential":
-        options["atmosphere"] = ExponentialAtmosphere(
-            scenario.rho0_kg_m3, scenario.h0_m, scenario.scale_height_m, args.density_scale
-        )
+        law = orbit_inputs.sphere_scenario(scenario, orbit.reference, args.inclination)
+        options["atmosphere"] = ExponentialAtmosphere(law.rho0_kg_m3, law.h0_m, law.scale_height_m, args.density_scale)
     else:
         options.update(
             activity=scenario.solar,
@@ -115,26 +126,37 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             ascending_node_local_time_h=args.node_local_time,
             chunk_days=args.chunk_days,
         )
-    result = lifetime(args.perigee, args.apogee, **options)
+    result = lifetime(perigee_km, apogee_km, **options)
     summary = result.to_dict()
+    summary.update(
+        perigee_km=orbit.perigee_km,
+        apogee_km=orbit.apogee_km,
+        height_reference=orbit.reference,
+        inclination_deg=args.inclination,
+        drag_parameter_m2_kg=satellite.drag_parameter_m2_kg,
+        drag_parameter_source=drag_source,
+        **drag_report,
+    )
+    if orbit.elements is not None:
+        summary.update(orbit_inputs.elements_report(orbit.elements))
     rule = None
     if args.rule is not None:
         rule = check_rule(
-            args.perigee,
-            args.apogee,
+            perigee_km,
+            apogee_km,
             args.rule,
             satellite=satellite,
-            scenario=scenario,
+            scenario=orbit_inputs.sphere_scenario(scenario, orbit.reference, args.inclination),
             inclination_deg=args.inclination,
         )
         summary.update(
             rule_years=args.rule,
             complies=bool(rule.complies[0]),
-            new_perigee_km=float(rule.new_perigee_m[0]) / 1e3,
+            new_perigee_km=float(rule.new_perigee_m[0]) / 1e3 - offset,
             dv_m_s=float(rule.dv_m_s[0]),
         )
     if args.trajectory:
-        write_csv(args.trajectory, result.history.rows())
+        write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset))
     if args.plot:
         from orbit_env.analysis.plots import plot_history
 
@@ -142,11 +164,9 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summary))
         return 0
-    print(f"orbit              {result.perigee_km:g} x {result.apogee_km:g} km")
-    print(
-        f"satellite          c_x {satellite.drag_coefficient:g}, {satellite.mass_kg:g} kg, "
-        f"{satellite.area_m2:.4g} m^2 (G/F = {satellite.mass_per_area_kg_m2:.4g} kg/m^2)"
-    )
+    for line in orbit_inputs.orbit_lines(orbit, args.inclination):
+        print(line)
+    print(orbit_inputs.satellite_line(satellite, drag_source, drag_report))
     print(f"atmosphere         {scenario.describe(args.inclination)}")
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")
@@ -159,7 +179,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         else:
             print(
                 f"{args.rule:g}-year rule       does not comply; smallest burn at apogee: {rule.dv_m_s[0]:.2f} m/s "
-                f"(retrograde), lowering the perigee to {rule.new_perigee_m[0] / 1e3:.1f} km"
+                f"(retrograde), lowering the perigee to {rule.new_perigee_m[0] / 1e3 - offset:.1f} km"
             )
     return 0
 
@@ -177,13 +197,19 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
     if args.method is not None:
         raise ValueError("--batch always uses the universal curves; do not give --method")
     start = time.perf_counter()
-    rows, hp, ha, c, inc, status = read_batch(
-        args.batch, satellite.drag_coefficient, satellite.drag_parameter_m2_kg, args.inclination
-    )
+    rows, hp, ha, c, inc, status = orbit_inputs.read_orbits(args, satellite, read_batch)
     records, summary = batch_lifetimes(
-        rows, hp, ha, c, inc, status, scenario, rule_years=args.rule, progress=not args.no_progress
+        rows,
+        hp,
+        ha,
+        c,
+        inc,
+        status,
+        orbit_inputs.sphere_scenario(scenario, args.height_reference, args.inclination),
+        rule_years=args.rule,
+        progress=not args.no_progress,
     )
-    write_records(args.out, records)
+    write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
     elapsed = time.perf_counter() - start
     print(
         f"wrote {summary.rows} rows to {args.out} ({summary.ok} with lifetimes, {summary.rows - summary.ok} with a "
@@ -195,6 +221,10 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
 def _cmd_fit_density(args: argparse.Namespace) -> int:
     from orbit_env.analysis.density_fit import fit_density_scale, read_observations
 
+    if args.inclination is None:
+        args.inclination = 0.0
+    if args.atmosphere is None:
+        args.atmosphere = "msis" if args.epoch is not None else "paper"
     satellite = _satellite(args)
     scenario = _scenario(args)
     observations = read_observations(args.observations)
@@ -220,17 +250,21 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     return 0
 
 
-def _add_satellite_options(parser: argparse.ArgumentParser) -> None:
+def _add_satellite_options(parser: argparse.ArgumentParser, shapes: bool = False) -> None:
     group = parser.add_argument_group("satellite")
-    group.add_argument("--cx", type=number, default=2.0, help="drag coefficient (default 2.0)")
+    group.add_argument("--cx", type=number, help="drag coefficient (default 2.0; with --tle: from B*)")
     group.add_argument("--mass", type=number, metavar="KG", help="mass [kg] (with --area; default the paper's 10 kg)")
     group.add_argument("--area", type=number, metavar="M2", help="reference area [m^2] (default 0.5 m sphere)")
     group.add_argument("--mass-per-area", type=number, metavar="KG_M2", help="transverse load G/F [kg/m^2]")
+    if shapes:
+        orbit_inputs.add_shape_options(group)
 
 
 def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("atmosphere")
-    group.add_argument("--atmosphere", choices=ATMOSPHERES, default="paper", help="density model (default paper)")
+    group.add_argument(
+        "--atmosphere", choices=ATMOSPHERES, help="density model (default: msis with an epoch or a TLE, else paper)"
+    )
     group.add_argument("--rho100", type=number, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
     group.add_argument("--density-scale", type=number, default=1.0, help="multiply the density (default 1)")
     group.add_argument("--rho0", type=number, metavar="KG_M3", help="exponential: density at --h0-km (default 1.3)")
@@ -249,7 +283,7 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")
     group.add_argument("--rotating-atmosphere", action="store_true", help="air co-rotates with the Earth")
     group.add_argument(
-        "--inclination", type=number, default=0.0, metavar="DEG", help="inclination (rotating air; msis latitudes)"
+        "--inclination", type=number, metavar="DEG", help="inclination (rotating air; msis latitudes; default 0)"
     )
 
 
@@ -258,7 +292,8 @@ def add_parsers(sub: Any) -> None:
     life = sub.add_parser("lifetime", help="lifetime of a satellite on an orbit, to re-entry at 100 km perigee")
     life.add_argument("--perigee", type=number, metavar="KM", help="perigee height [km]")
     life.add_argument("--apogee", type=number, metavar="KM", help="apogee height [km]")
-    _add_satellite_options(life)
+    orbit_inputs.add_orbit_options(life)
+    _add_satellite_options(life, shapes=True)
     life.add_argument(
         "--method",
         choices=METHODS,

@@ -1,0 +1,232 @@
+"""Element sets: two- and three-line element sets (TLE) and mean elements, read into orbits and drag.
+
+An analyst's orbit is a TLE (from CelesTrak or Space-Track) or a mean semi-major axis
+and eccentricity. This module reads TLEs through the ``sgp4`` package (Brandon Rhodes,
+MIT licence; Vallado et al. 2006, "Revisiting Spacetrack Report #3"), after checking
+each line's layout and checksum itself so that a malformed set is a one-line error
+naming the file's line.
+
+Units: km for heights and the semi-major axis (the user's units), unix days for the
+epoch, m^2/kg for the drag parameter. Heights from elements are above the WGS84
+equatorial radius, as catalogues quote them: ``a (1 - e) - 6378.137 km`` and
+``a (1 + e) - 6378.137 km``.
+
+The drag parameter from B*: SGP4's B* = (C_D A / m) rho0 / 2 with the reference
+density rho0 = 0.15696615 kg/(m^2 ER) (Vallado, *Fundamentals of Astrodynamics and
+Applications*, 4th ed., section 9.7.2), so ``C_D A / m = 2 B* / rho0``. B* is a
+fitted parameter: it absorbs density-model errors too, and can be zero or negative,
+in which case no drag parameter follows from it (give the satellite instead).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from orbit_env.checks import check_number
+from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M
+
+#: SGP4's reference density of B* [kg/(m^2 ER)]: C_D A / m = 2 B* / rho0.
+BSTAR_REFERENCE_DENSITY = 0.15696615
+#: WGS84 equatorial radius [km], the surface element-set heights are quoted above.
+EQUATORIAL_RADIUS_KM = EARTH_EQUATORIAL_RADIUS_M / 1e3
+#: Length of a TLE line (69 columns, the last one the checksum).
+TLE_LINE_LENGTH = 69
+
+
+def tle_checksum(line: str) -> int:
+    """The checksum of a TLE line's first 68 columns: the sum of its digits, each '-' counting 1, mod 10."""
+    return sum(int(ch) if ch.isdigit() else 1 if ch == "-" else 0 for ch in line[:68]) % 10
+
+
+@dataclass(frozen=True)
+class ElementSet:
+    """One satellite's mean elements at an epoch.
+
+    Attributes:
+        name: The satellite's name (a three-line set's line 0), or the catalogue number.
+        epoch_days: Epoch, unix days (UTC).
+        semi_major_axis_km: Mean semi-major axis (for a TLE: SGP4's Brouwer mean, from the mean motion).
+        eccentricity: Mean eccentricity.
+        inclination_deg: Inclination.
+        bstar_per_earth_radius: SGP4's drag term B* [1/ER] (None: not from a TLE).
+        line: The file's line number of the set's first line (0: not from a file).
+    """
+
+    name: str
+    epoch_days: float | None
+    semi_major_axis_km: float
+    eccentricity: float
+    inclination_deg: float
+    bstar_per_earth_radius: float | None = None
+    line: int = 0
+
+    @property
+    def perigee_km(self) -> float:
+        """Perigee height above the equatorial radius, a (1 - e) - 6378.137 km."""
+        return self.semi_major_axis_km * (1.0 - self.eccentricity) - EQUATORIAL_RADIUS_KM
+
+    @property
+    def apogee_km(self) -> float:
+        """Apogee height above the equatorial radius, a (1 + e) - 6378.137 km."""
+        return self.semi_major_axis_km * (1.0 + self.eccentricity) - EQUATORIAL_RADIUS_KM
+
+    @property
+    def drag_parameter_m2_kg(self) -> float | None:
+        """C_D A / m = 2 B* / rho0 [m^2/kg]; None when there is no positive B*."""
+        if self.bstar_per_earth_radius is None or self.bstar_per_earth_radius <= 0.0:
+            return None
+        return 2.0 * self.bstar_per_earth_radius / BSTAR_REFERENCE_DENSITY
+
+    @property
+    def epoch_iso(self) -> str | None:
+        """The epoch as ISO 8601 UTC to the second (None without an epoch)."""
+        if self.epoch_days is None:
+            return None
+        import numpy as np
+
+        return str(np.datetime64(round(self.epoch_days * 86400.0), "s")) + "Z"
+
+
+def mean_elements(semi_major_axis_km: float, eccentricity: float, inclination_deg: float = 0.0) -> ElementSet:
+    """An element set from a mean semi-major axis and eccentricity (heights above the equatorial radius).
+
+    Raises:
+        InputError: a value out of range (eccentricity in [0, 1), perigee above the surface).
+    """
+    e = check_number(eccentricity, "eccentricity", low=0.0, high=1.0, high_inclusive=False)
+    a = check_number(
+        semi_major_axis_km,
+        "semi_major_axis_km",
+        unit="km",
+        low=EQUATORIAL_RADIUS_KM / (1.0 - e),
+        why="the perigee a (1 - e) must be above the equatorial radius 6378.137 km",
+        low_inclusive=False,
+    )
+    inc = check_number(inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
+    return ElementSet("mean elements", None, a, e, inc)
+
+
+def _check_line(text: str, number: str, where: str) -> None:
+    """Raise ValueError naming ``where`` if ``text`` is not a well-formed TLE line ``number``."""
+    if len(text) != TLE_LINE_LENGTH:
+        raise ValueError(f"{where}: a TLE line has {TLE_LINE_LENGTH} columns, this one {len(text)}")
+    if not text.startswith(number + " "):
+        raise ValueError(f"{where}: expected TLE line {number}, found {text[:10]!r}")
+    if not text[68].isdigit():
+        raise ValueError(f"{where}: the last column must be the checksum digit, found {text[68]!r}")
+    expected = tle_checksum(text)
+    if int(text[68]) != expected:
+        raise ValueError(f"{where}: bad checksum {text[68]} (the line sums to {expected})")
+
+
+def parse_tle(
+    line1: str, line2: str, name: str | None = None, *, source: str = "TLE", first_line: int = 1
+) -> ElementSet:
+    """One element set from its two lines (through ``sgp4``).
+
+    Args:
+        line1: TLE line 1.
+        line2: TLE line 2.
+        name: The satellite's name (line 0 of a three-line set).
+        source: The file's name, for messages.
+        first_line: The file's line number of ``line1``, for messages.
+
+    Raises:
+        ValueError: a line's layout or checksum is wrong, the two lines name different
+            satellites, or SGP4 refuses the elements; the message names the line.
+    """
+    from sgp4.api import WGS72, Satrec
+
+    line1, line2 = line1.rstrip(), line2.rstrip()
+    where1, where2 = f"{source}, line {first_line}", f"{source}, line {first_line + 1}"
+    _check_line(line1, "1", where1)
+    _check_line(line2, "2", where2)
+    if line1[2:7] != line2[2:7]:
+        raise ValueError(f"{where2}: catalogue number {line2[2:7].strip()} differs from line 1's {line1[2:7].strip()}")
+    try:
+        satrec = Satrec.twoline2rv(line1, line2, WGS72)
+    except ValueError as error:
+        raise ValueError(f"{where1}: cannot read the element set ({error})") from None
+    if satrec.error != 0:
+        raise ValueError(
+            f"{where1}: SGP4 refuses the elements (error {satrec.error}: {_SGP4_ERRORS.get(satrec.error)})"
+        )
+    epoch_days = (satrec.jdsatepoch - 2440587.5) + satrec.jdsatepochF
+    # satrec.a is the Brouwer mean semi-major axis in Earth radii (of the WGS72 constants SGP4 uses).
+    a_km = satrec.a * satrec.radiusearthkm
+    return ElementSet(
+        name=(name or line1[2:7]).strip(),
+        epoch_days=epoch_days,
+        semi_major_axis_km=a_km,
+        eccentricity=satrec.ecco,
+        inclination_deg=math.degrees(satrec.inclo),
+        bstar_per_earth_radius=satrec.bstar,
+        line=first_line,
+    )
+
+
+_SGP4_ERRORS = {
+    1: "mean eccentricity out of range",
+    2: "mean motion below zero",
+    3: "perturbed eccentricity out of range",
+    4: "semi-latus rectum below zero",
+    6: "the orbit has decayed",
+}
+
+
+def parse_tle_text(lines: Iterable[str], source: str = "TLE") -> list[ElementSet]:
+    """Every element set of a text in CelesTrak's format: two-line sets, or three-line sets with a name line.
+
+    Blank lines are skipped; a name line is any line that does not start with ``1 `` or
+    ``2 `` (a leading ``0 `` is dropped, as Space-Track writes it).
+
+    Raises:
+        ValueError: a malformed set (the message names the file's line), or no set at all.
+    """
+    numbered = [(i + 1, text.rstrip("\r\n").rstrip()) for i, text in enumerate(lines)]
+    numbered = [(i, text) for i, text in numbered if text.strip()]
+    sets: list[ElementSet] = []
+    k = 0
+    while k < len(numbered):
+        number, text = numbered[k]
+        name = None
+        if not text.startswith(("1 ", "2 ")):
+            name = text[2:] if text.startswith("0 ") else text
+            k += 1
+            if k >= len(numbered):
+                raise ValueError(f"{source}, line {number}: a name line without its two element lines")
+            number, text = numbered[k]
+        if k + 1 >= len(numbered):
+            raise ValueError(f"{source}, line {number}: TLE line 1 without its line 2")
+        next_number, next_text = numbered[k + 1]
+        if next_number != number + 1:
+            raise ValueError(f"{source}, line {number + 1}: expected TLE line 2, found a blank line")
+        sets.append(parse_tle(text, next_text, name, source=source, first_line=number))
+        k += 2
+    if not sets:
+        raise ValueError(f"{source}: no element set found")
+    return sets
+
+
+def read_tle(path: str | Path) -> list[ElementSet]:
+    """The element sets of a file (``-``: standard input); see :func:`parse_tle_text`.
+
+    Raises:
+        ValueError: a malformed set, naming the line.
+        OSError: the file cannot be read.
+    """
+    if str(path) == "-":
+        return parse_tle_text(sys.stdin.read().splitlines(), "<stdin>")
+    with open(path) as handle:
+        return parse_tle_text(handle.read().splitlines(), str(path))
+
+
+def looks_like_tle(path: str | Path) -> bool:
+    """Whether a file's first non-blank lines are an element set (rather than a CSV's header)."""
+    with open(path) as handle:
+        lines = [line.rstrip() for line in handle.readlines()[:6] if line.strip()]
+    return any(line.startswith("1 ") and len(line) == TLE_LINE_LENGTH for line in lines[:2])

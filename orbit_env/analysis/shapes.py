@@ -1,0 +1,127 @@
+"""A satellite's shape -> its free-molecular drag coefficient at the orbit's conditions (needs pymsis).
+
+The coefficient comes from :mod:`orbit_env.physics.drag` (Sentman 1961, diffuse
+re-emission, full energy accommodation, wall at 300 K). The gas's speed ratio and
+temperature are NRLMSIS 2.1's at the start: at the orbit's mean height, over its
+latitudes and local times (:func:`orbit_env.physics.atmosphere.msis.orbit_samples`),
+on the epoch's date with its indices, the coefficient density-weighted over these
+samples; it is then held for the whole life (along a decay from 500 km it falls by a
+few per cent, see docs/validation-modern.md).
+
+Units: SI (m, m^2, kg, K, m/s); heights above the package's 6371 km sphere.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
+from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples, require_pymsis
+from orbit_env.physics.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
+
+#: Energy accommodation of the drag model (Sentman's diffuse, fully accommodated re-emission).
+ACCOMMODATION = 1.0
+#: The date of the gas when no epoch is given (an equinox, at noon UTC).
+DEFAULT_GAS_DATE = "2000-03-20T12:00"
+#: Shapes the CLI knows (``--shape``).
+SHAPES: tuple[str, ...] = ("sphere",)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """What the air sees: a sphere, or flat panels at fixed incidence (flown in a fixed attitude).
+
+    Attributes:
+        reference_area_m2: The frontal area the drag coefficient refers to.
+        sphere: True for a sphere of that cross-section (the panels are then unused).
+        panel_areas_m2: Panel areas (one side each; a thin wing is two panels).
+        panel_cos_incidence: Cosine between each panel's outward normal and the direction the air comes from.
+    """
+
+    reference_area_m2: float
+    sphere: bool = False
+    panel_areas_m2: tuple[float, ...] = ()
+    panel_cos_incidence: tuple[float, ...] = ()
+
+    def drag_coefficient(self, s: np.ndarray, wall_to_gas: np.ndarray) -> np.ndarray:
+        """Drag coefficient on the reference area for speed ratios ``s`` and T_w / T (arrays alike)."""
+        if self.sphere:
+            return sphere_drag_coefficient(s, wall_to_gas, ACCOMMODATION)
+        areas = np.array(self.panel_areas_m2)
+        gamma = np.array(self.panel_cos_incidence)
+        return panel_drag_area_m2(areas, gamma, s, wall_to_gas, ACCOMMODATION) / self.reference_area_m2
+
+
+def sphere(diameter_m: float) -> Shape:
+    """A sphere of this diameter."""
+    from orbit_env.checks import check_number
+
+    d = check_number(diameter_m, "diameter_m", unit="m", low=0.0, low_inclusive=False)
+    return Shape(math.pi * d**2 / 4.0, sphere=True)
+
+
+def flown_nose_first(front_m2: float, parallel_m2: float) -> Shape:
+    """A prism flown along its axis: a front face, the same area in the wake, and flow-parallel surfaces."""
+    return Shape(front_m2, panel_areas_m2=(front_m2, front_m2, parallel_m2), panel_cos_incidence=(1.0, -1.0, 0.0))
+
+
+@dataclass(frozen=True)
+class DragAtStart:
+    """The drag coefficient on the reference area and the gas it was computed in (density-weighted means)."""
+
+    drag_coefficient: float
+    speed_ratio: float
+    temperature_k: float
+
+
+def drag_at_start(
+    shape: Shape,
+    height_m: float,
+    inclination_deg: float,
+    indices: tuple[float, float, float],
+    date: str | None = None,
+    *,
+    ascending_node_local_time_h: float | None = None,
+    rotating_atmosphere: bool = True,
+) -> DragAtStart:
+    """The free-molecular drag coefficient of ``shape`` at the mean height ``height_m`` (above the sphere).
+
+    Args:
+        shape: What the air sees.
+        height_m: The orbit's mean height above the 6371 km sphere.
+        inclination_deg: The orbit's inclination (sets the latitudes sampled).
+        indices: F10.7, its 81-day mean [sfu] and Ap of the date.
+        date: ISO date and time (None: :data:`DEFAULT_GAS_DATE`).
+        ascending_node_local_time_h: Sun-synchronous orbits: the node's local time.
+        rotating_atmosphere: Whether the speed is taken against co-rotating air.
+    """
+    msis = require_pymsis()
+    lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h)
+    start = np.datetime64(date or DEFAULT_GAS_DATE, "s")
+    ut_h = (start - start.astype("datetime64[D]")).astype(np.int64) / 3600.0
+    lon = np.mod((local_time - ut_h) * 15.0, 360.0)
+    f107, f107a, ap = (float(x) for x in indices)
+    out = msis.calculate(
+        np.full(lat.size, start),
+        lon,
+        lat,
+        geodetic_altitude_m(height_m, lat) / 1e3,
+        f107s=np.full(lat.size, f107),
+        f107as=np.full(lat.size, f107a),
+        aps=np.full((lat.size, 7), ap),
+        version=2.1,
+    )
+    rho, temperature = out[:, 0], out[:, 10]
+    molecular_mass = rho / np.nansum(out[:, 1:10], axis=1)
+    radius_m = EARTH_RADIUS_M + height_m
+    speed = math.sqrt(MU_EARTH_M3_S2 / radius_m)
+    if rotating_atmosphere:
+        # The air's eastward speed projected on the track averages omega r cos i.
+        speed -= EARTH_ROTATION_RAD_S * radius_m * math.cos(math.radians(inclination_deg))
+    s = speed_ratio(speed, temperature, molecular_mass)
+    cd = shape.drag_coefficient(s, WALL_TEMPERATURE_K / temperature)
+    weight = rho / rho.sum()
+    return DragAtStart(float(np.sum(weight * cd)), float(np.sum(weight * s)), float(np.sum(weight * temperature)))

@@ -1,0 +1,343 @@
+"""The orbit and the satellite as an analyst gives them: an element set, mean elements or heights; a shape.
+
+Shared by ``orbit-env lifetime`` and ``fit-density``. The orbit comes from one of
+
+* ``--perigee KM --apogee KM`` (heights above ``--height-reference``),
+* ``--semi-major-axis-km KM --eccentricity E`` (mean elements; heights a (1 -+ e) - 6378.137 km),
+* ``--tle FILE`` (a two- or three-line element set, ``-`` for stdin): epoch, mean elements,
+  inclination and, unless the satellite is given, the drag parameter from B*.
+
+Heights are converted to the decay core's 6371 km sphere here (:mod:`orbit_env.analysis.heights`)
+and back for what is printed. Heavy imports (sgp4, pymsis) happen inside the functions.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, replace
+from typing import Any
+
+from orbit_env.analysis.heights import (
+    HEIGHT_REFERENCES,
+    default_height_reference,
+    exponential_at_geodetic_altitude,
+    offset_km,
+)
+from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
+from orbit_env.cli.common import given, number
+
+#: What ``drag_parameter_source`` says in JSON.
+SOURCE_BSTAR = "bstar"
+SOURCE_SATELLITE = "satellite"
+SOURCE_SHAPE = "shape"
+SOURCE_DEFAULT = "default"
+_SATELLITE_FLAGS = ("mass", "area", "mass_per_area", "cx", "shape")
+
+
+@dataclass(frozen=True)
+class OrbitInput:
+    """The start orbit as given, and what it is measured from.
+
+    Attributes:
+        perigee_km: Perigee height above ``reference`` (None: not given).
+        apogee_km: Apogee height above ``reference``.
+        reference: ``equatorial`` or ``sphere``.
+        elements: The element set, if the orbit came from one.
+    """
+
+    perigee_km: float | None
+    apogee_km: float | None
+    reference: str
+    elements: Any = None
+
+    @property
+    def offset_km(self) -> float:
+        """Height of the reference surface above the 6371 km sphere."""
+        return offset_km(self.reference)
+
+    @property
+    def sphere_heights_km(self) -> tuple[float, float]:
+        """Perigee and apogee above the 6371 km sphere (the decay core's heights)."""
+        assert self.perigee_km is not None and self.apogee_km is not None
+        return self.perigee_km + self.offset_km, self.apogee_km + self.offset_km
+
+
+def add_orbit_options(parser: argparse.ArgumentParser) -> None:
+    """``--tle``, ``--semi-major-axis-km``, ``--eccentricity``, ``--height-reference``."""
+    group = parser.add_argument_group("orbit from elements")
+    group.add_argument(
+        "--tle", metavar="FILE", help="two- or three-line element set ('-': stdin): epoch, orbit, inclination, B*"
+    )
+    group.add_argument("--semi-major-axis-km", type=number, metavar="KM", help="mean semi-major axis [km]")
+    group.add_argument("--eccentricity", type=number, metavar="E", help="mean eccentricity (with --semi-major-axis-km)")
+    group.add_argument(
+        "--height-reference",
+        choices=HEIGHT_REFERENCES,
+        help="heights above the WGS84 equatorial radius 6378.137 km or the 6371 km sphere "
+        "(default: equatorial for msis and exponential, sphere for the paper's atmosphere)",
+    )
+
+
+def add_shape_options(group: Any) -> None:
+    """``--shape`` and ``--diameter-m`` in the satellite group."""
+    group.add_argument(
+        "--shape", choices=("sphere",), help="free-molecular C_D of this shape at the orbit (needs --mass)"
+    )
+    group.add_argument("--diameter-m", type=number, metavar="M", help="with --shape sphere: its diameter [m]")
+
+
+def prepare(args: argparse.Namespace) -> OrbitInput:
+    """Read the orbit options; fill in the epoch, inclination and atmosphere an element set implies.
+
+    Sets ``args.atmosphere`` (msis when there is an epoch and no ``--atmosphere``, else
+    paper), ``args.epoch`` (a TLE's, unless given), ``args.inclination`` (a TLE's, else 0)
+    and ``args.height_reference``.
+    """
+    elements = None
+    tle = getattr(args, "tle", None)
+    mean_a = getattr(args, "semi_major_axis_km", None)
+    ecc = getattr(args, "eccentricity", None)
+    perigee, apogee = getattr(args, "perigee", None), getattr(args, "apogee", None)
+    if tle is not None:
+        from orbit_env.analysis.elements import read_tle
+
+        if mean_a is not None or ecc is not None or perigee is not None or apogee is not None:
+            raise ValueError("--tle gives the orbit; do not give --perigee/--apogee or --semi-major-axis-km too")
+        if getattr(args, "batch", None):
+            raise ValueError("give either --tle or --batch (a batch file may hold element sets)")
+        sets = read_tle(tle)
+        if len(sets) > 1:
+            raise ValueError(f"{tle} holds {len(sets)} element sets; use --batch for more than one")
+        elements = sets[0]
+        if args.epoch is None and args.atmosphere in (None, "msis"):
+            args.epoch = elements.epoch_iso.rstrip("Z")
+        if args.inclination is None:
+            args.inclination = elements.inclination_deg
+    elif mean_a is not None or ecc is not None:
+        from orbit_env.analysis.elements import mean_elements
+
+        if mean_a is None or ecc is None:
+            raise ValueError("give --semi-major-axis-km and --eccentricity together")
+        if perigee is not None or apogee is not None:
+            raise ValueError("give either --perigee/--apogee or --semi-major-axis-km/--eccentricity, not both")
+        elements = mean_elements(mean_a, ecc, 0.0 if args.inclination is None else args.inclination)
+    if args.inclination is None:
+        args.inclination = 0.0
+    if args.atmosphere is None:
+        args.atmosphere = "msis" if args.epoch is not None else "paper"
+    reference = getattr(args, "height_reference", None)
+    if reference is None:
+        reference = "equatorial" if elements is not None else default_height_reference(args.atmosphere)
+    args.height_reference = reference
+    if elements is not None:
+        if reference != "equatorial":
+            raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
+        return OrbitInput(elements.perigee_km, elements.apogee_km, reference, elements)
+    return OrbitInput(perigee, apogee, reference)
+
+
+def satellite_from_args(
+    args: argparse.Namespace, orbit: OrbitInput, scenario: Any
+) -> tuple[Satellite, str, dict[str, Any]]:
+    """The satellite, where its drag parameter came from, and what to report about it.
+
+    The satellite's flags win; else a TLE's B*; else the paper's sphere. ``--shape``
+    computes the free-molecular C_D at the start (``--cx`` still overrides it).
+    """
+    cx = PAPER_DRAG_COEFFICIENT if args.cx is None else args.cx
+    shape = getattr(args, "shape", None)
+    report: dict[str, Any] = {}
+    if shape is None and getattr(args, "diameter_m", None) is not None:
+        raise ValueError("--diameter-m goes with --shape sphere")
+    if shape is not None:
+        if args.diameter_m is None:
+            raise ValueError("--shape sphere needs --diameter-m")
+        if args.mass is None:
+            raise ValueError("--shape needs --mass (the drag parameter is C_D A / m)")
+        if args.area is not None or args.mass_per_area is not None:
+            raise ValueError("--shape sets the area; do not give --area or --mass-per-area")
+        from orbit_env.analysis.shapes import sphere
+
+        body = sphere(args.diameter_m)
+        if args.cx is None and orbit.perigee_km is not None and orbit.apogee_km is not None:
+            cx, conditions = _shape_drag_coefficient(body, orbit, scenario, args)
+            report.update(conditions)
+        return make_satellite(cx, args.mass, body.reference_area_m2), SOURCE_SHAPE, report
+    satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
+    elements = orbit.elements
+    if not satellite_given and elements is not None and elements.bstar_per_earth_radius is not None:
+        c = elements.drag_parameter_m2_kg
+        if c is None:
+            raise ValueError(
+                f"the element set's B* = {elements.bstar_per_earth_radius:g} /ER gives no drag parameter "
+                "(it must be above 0); give the satellite: --mass and --area (or --shape)"
+            )
+        report["bstar_per_earth_radius"] = elements.bstar_per_earth_radius
+        # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
+        return Satellite(1.0, 1.0, c), SOURCE_BSTAR, report
+    satellite = make_satellite(cx, args.mass, args.area, args.mass_per_area)
+    return satellite, SOURCE_SATELLITE if satellite_given else SOURCE_DEFAULT, report
+
+
+def _shape_drag_coefficient(body: Any, orbit: OrbitInput, scenario: Any, args: argparse.Namespace) -> Any:
+    """The shape's C_D at the start orbit's mean height, in the scenario's gas (NRLMSIS)."""
+    from orbit_env.analysis.shapes import drag_at_start
+    from orbit_env.decay.solar import ConstantActivity
+
+    hp, ha = orbit.sphere_heights_km
+    if scenario.atmosphere == "msis":
+        start = scenario.epoch_days
+        indices = scenario.solar.indices(start) if start is not None else _constant(scenario.solar)
+        date = None if start is None else str(_datetime(start))
+    else:
+        # Other atmospheres have no temperature: the gas is NRLMSIS's at moderate activity.
+        indices, date = _constant(ConstantActivity(150.0, 150.0, 15.0)), None
+    result = drag_at_start(
+        body,
+        0.5 * (hp + ha) * 1e3,
+        args.inclination,
+        tuple(float(x) for x in indices),
+        date,
+        ascending_node_local_time_h=getattr(args, "node_local_time", None),
+        rotating_atmosphere=True,
+    )
+    return result.drag_coefficient, {
+        "drag_coefficient": result.drag_coefficient,
+        "speed_ratio": result.speed_ratio,
+        "gas_temperature_k": result.temperature_k,
+    }
+
+
+def _constant(activity: Any) -> tuple[float, float, float]:
+    return float(activity.f107_sfu), float(activity.f107a_sfu), float(activity.ap)
+
+
+def _datetime(days: float) -> Any:
+    import numpy as np
+
+    return np.datetime64(round(days * 86400.0), "s")
+
+
+def sphere_scenario(scenario: Any, reference: str, inclination_deg: float) -> Any:
+    """The scenario in the sphere's heights: the exponential law at the geodetic altitude (equatorial reference)."""
+    if scenario.atmosphere != "exponential" or reference != "equatorial":
+        return scenario
+    from orbit_env.physics.atmosphere import ExponentialAtmosphere
+
+    law = exponential_at_geodetic_altitude(
+        ExponentialAtmosphere(scenario.rho0_kg_m3, scenario.h0_m, scenario.scale_height_m), inclination_deg
+    )
+    return replace(scenario, rho0_kg_m3=law.rho0_kg_m3, h0_m=law.h0_m)
+
+
+def elements_report(elements: Any) -> dict[str, Any]:
+    """What JSON says about an element set."""
+    report: dict[str, Any] = {
+        "semi_major_axis_km": elements.semi_major_axis_km,
+        "eccentricity": elements.eccentricity,
+    }
+    if elements.epoch_days is not None:
+        report.update(name=elements.name, epoch=elements.epoch_iso)
+    return report
+
+
+def orbit_lines(orbit: OrbitInput, inclination_deg: float) -> list[str]:
+    """The text output's lines about the orbit."""
+    from orbit_env.analysis.heights import describe
+
+    lines = []
+    elements = orbit.elements
+    if elements is not None and elements.epoch_days is not None:
+        lines.append(
+            f"element set        {elements.name}, epoch {elements.epoch_iso}, inclination {inclination_deg:g} deg"
+        )
+    if elements is not None:
+        lines.append(f"mean elements      a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f}")
+    assert orbit.perigee_km is not None and orbit.apogee_km is not None
+    lines.append(f"orbit              {orbit.perigee_km:.6g} x {orbit.apogee_km:.6g} km, {describe(orbit.reference)}")
+    return lines
+
+
+def satellite_line(satellite: Satellite, source: str, report: dict[str, Any]) -> str:
+    """The text output's line about the satellite."""
+    c = satellite.drag_parameter_m2_kg
+    if source == SOURCE_BSTAR:
+        return (
+            f"satellite          c_x A/m = {c:.4g} m^2/kg from the element set's B* = "
+            f"{report['bstar_per_earth_radius']:.5g} /ER (2 B* / 0.15696615)"
+        )
+    text = (
+        f"satellite          c_x {satellite.drag_coefficient:.4g}, {satellite.mass_kg:g} kg, "
+        f"{satellite.area_m2:.4g} m^2 (G/F = {satellite.mass_per_area_kg_m2:.4g} kg/m^2, c_x A/m = {c:.4g} m^2/kg)"
+    )
+    if "speed_ratio" in report:
+        text += (
+            f"; free-molecular c_x (Sentman) at S = {report['speed_ratio']:.2f}, "
+            f"T = {report['gas_temperature_k']:.0f} K"
+        )
+    return text
+
+
+def history_rows(history: Any, offset: float) -> list[dict[str, float]]:
+    """The decay history's rows with heights above the reference."""
+    rows = history.rows()
+    for row in rows:
+        row["perigee_km"] -= offset
+        row["apogee_km"] -= offset
+    return rows
+
+
+def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any) -> tuple[Any, ...]:
+    """A batch file's orbits in the sphere's heights [m]: a CSV (see ``catalogue``) or element sets.
+
+    Element sets give heights above the equatorial radius, their inclination, and the drag
+    parameter from B* unless the satellite is given on the command line.
+    """
+    import numpy as np
+
+    from orbit_env.analysis.elements import looks_like_tle, read_tle
+
+    offset_m = offset_km(args.height_reference) * 1e3
+    if not looks_like_tle(args.batch):
+        rows, hp, ha, c, inc, status = read_batch(
+            args.batch, satellite.drag_coefficient, satellite.drag_parameter_m2_kg, args.inclination
+        )
+        return rows, hp + offset_m, ha + offset_m, c, inc, status
+    if args.height_reference != "equatorial":
+        raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
+    sets = read_tle(args.batch)
+    satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
+    rows = [{"name": s.name} for s in sets]
+    hp = np.array([s.perigee_km for s in sets]) * 1e3 + offset_m
+    ha = np.array([s.apogee_km for s in sets]) * 1e3 + offset_m
+    inc = np.array([s.inclination_deg for s in sets])
+    c = np.full(len(sets), satellite.drag_parameter_m2_kg)
+    status = ["ok"] * len(sets)
+    for i, s in enumerate(sets):
+        if not satellite_given:
+            value = s.drag_parameter_m2_kg
+            if value is None:
+                status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
+            else:
+                c[i] = value
+    from orbit_env.decay.curves import UniversalCurves
+
+    for i in range(len(sets)):
+        if status[i] == "ok":
+            try:
+                UniversalCurves.check_domain(hp[i], ha[i])
+            except ValueError as error:
+                status[i] = f"line {sets[i].line}: {error}"
+    return rows, hp, ha, c, inc, status
+
+
+def records_in_reference(records: list[dict[str, Any]], reference: str) -> list[dict[str, Any]]:
+    """Batch records with heights above the reference (the records hold the sphere's)."""
+    shift = offset_km(reference)
+    if shift == 0.0:
+        return records
+    for record in records:
+        for key in ("perigee_km", "apogee_km", "new_perigee_km"):
+            if record.get(key, "") != "":
+                record[key] = f"{float(record[key]) - shift:.6g}"
+    return records
