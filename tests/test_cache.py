@@ -58,3 +58,18 @@ def test_the_cache_can_be_disabled(tmp_path, monkeypatch):
     monkeypatch.setenv(cache.ENV_VAR, str(tmp_path))
     monkeypatch.setattr(cache, "_disabled", True)  # what orbit-env --no-cache sets
     assert cache.cache_dir() is None
+
+
+def test_no_cache_flag_writes_nothing(folder, monkeypatch, capsys):
+    from orbit_env.cli import main
+
+    monkeypatch.setattr(cache, "_disabled", False)  # restored after the test: --no-cache sets it for the process
+    args = ["lifetime", "--perigee", "300", "--apogee", "400", "--atmosphere", "exponential"]
+    args += ["--rho0", "2e-11", "--h0-km", "350", "--scale-height-km", "55", "--method", "curves"]
+    assert main([*args, "--no-cache"]) == 0
+    assert not list(folder.iterdir())
+    monkeypatch.setattr(cache, "_disabled", False)
+    args[args.index("2e-11")] = "3e-11"  # another atmosphere: not in this process's memory either
+    assert main(args) == 0
+    assert len(list(folder.glob("curves-*.npz"))) == 1
+    capsys.readouterr()

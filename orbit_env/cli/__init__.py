@@ -12,6 +12,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
+from orbit_env import cache
 from orbit_env.checks import InputError
 from orbit_env.cli import agents, lifetime, paper
 from orbit_env.cli.common import FLAGS, PROG, Parser, in_flags
@@ -26,6 +27,12 @@ def build_parser() -> Parser:
     lifetime.add_parsers(sub)
     paper.add_parsers(sub)
     agents.add_parsers(sub)
+    for command in sub.choices.values():
+        command.add_argument(
+            "--no-cache",
+            action="store_true",
+            help=f"neither read nor write the disk cache of curves and profiles ({cache.ENV_VAR}=off does the same)",
+        )
     return parser
 
 
@@ -33,6 +40,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.no_cache:
+        cache.disable()
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
