@@ -73,3 +73,9 @@ def test_no_cache_flag_writes_nothing(folder, monkeypatch, capsys):
     assert main(args) == 0
     assert len(list(folder.glob("curves-*.npz"))) == 1
     capsys.readouterr()
+
+
+def test_the_default_curves_are_one_table_in_a_process():
+    from orbit_env.decay.curves import universal_curves
+
+    assert universal_curves() is universal_curves(DecayModel()) is universal_curves(DecayModel(PaperAtmosphere()))

@@ -518,7 +518,12 @@ def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike 
     return G0_M_S2 * np.multiply(drag_parameter_m2_kg, density_scale, dtype=np.float64)
 
 
-@lru_cache(maxsize=8)
 def universal_curves(model: DecayModel | None = None) -> UniversalCurves:
-    """The universal curves of ``model`` (default: the paper's), built once and cached."""
-    return UniversalCurves(model or DecayModel())
+    """The universal curves of ``model`` (default: the paper's), built once per process and kept on disk."""
+    return _curves_of(model or DecayModel())
+
+
+@lru_cache(maxsize=8)
+def _curves_of(model: DecayModel) -> UniversalCurves:
+    # Keyed by the model itself: universal_curves() and universal_curves(DecayModel()) share one table.
+    return UniversalCurves(model)
