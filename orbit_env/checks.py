@@ -43,7 +43,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["InputError", "check_array", "check_int", "check_number", "format_number"]
+__all__ = ["DATE_RANGE", "InputError", "check_array", "check_date", "check_int", "check_number", "format_number"]
+
+#: Dates an orbit may have (epochs, observations, re-entries), as unix days and ISO dates: from
+#: Sputnik 1's launch to the end of 2200, beyond which no solar record, forecast or atmosphere
+#: model of this package means anything.
+DATE_RANGE = ((-4472.0, "1957-10-04"), (84_370.0, "2200-12-31"))
 
 
 def format_number(value: Any) -> str:
@@ -261,6 +266,29 @@ def check_number(
     ):
         raise InputError(name, value, "range", integer=integer, **bounds)
     return x
+
+
+def check_date(days: float, name: str, *, text: str | None = None) -> float:
+    """Check a date given as unix days (days since 1970-01-01) against :data:`DATE_RANGE`.
+
+    Args:
+        days: The date as unix days.
+        name: The parameter (``"epoch"``) or flag (``"--epoch"``) it came from.
+        text: The date as typed, shown in the message (default: ``days``).
+
+    Raises:
+        ValueError: the date is not finite or lies outside the range; the message
+            names ``name``, the date as typed and the range as dates.
+    """
+    (low, low_date), (high, high_date) = DATE_RANGE
+    shown = format_number(days) if text is None else text
+    label = f"{name} {shown}" if name.startswith("-") else f"{name}={shown!r}" if text else f"{name}={shown}"
+    if not (math.isfinite(days) and low <= days < high + 1.0):
+        raise ValueError(
+            f"{label} is out of range; allowed: {low_date} to {high_date} "
+            "(no satellite flew before Sputnik 1; the models here do not reach beyond 2200)"
+        )
+    return float(days)
 
 
 def check_int(value: Any, name: str, *, low: int | None = None, high: int | None = None, why: str = "") -> int:
