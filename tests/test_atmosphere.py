@@ -67,9 +67,20 @@ def test_paper_atmosphere_rejects_bad_parameters(kwargs, message):
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"rho0_kg_m3": 0.0}, "rho0_kg_m3=0 is out of range; allowed: above 0 kg/m^3"),
-        ({"h0_m": float("inf")}, "h0_m=inf is not a finite number; allowed: a finite number"),
-        ({"scale_height_m": -8500.0}, "scale_height_m=-8500 is out of range; allowed: above 0 m"),
+        (
+            {"rho0_kg_m3": 0.0},
+            "rho0_kg_m3=0 is out of range; allowed: above 0 and at most 10 kg/m^3 (air at sea level is 1.2 kg/m^3)",
+        ),
+        (
+            {"h0_m": float("inf")},
+            "h0_m=inf is not a finite number; allowed: 0 to 2000000 m "
+            "(from sea level to the top of the orbits computed here)",
+        ),
+        (
+            {"scale_height_m": -8500.0},
+            "scale_height_m=-8500 is out of range; allowed: 1000 to 500000 m "
+            "(the air's scale height runs from 6 km near the ground to 100 km at 1000 km)",
+        ),
         ({"scale": -2.0}, "scale=-2 is out of range; allowed: above 0"),
     ],
 )

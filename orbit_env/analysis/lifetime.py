@@ -14,11 +14,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
-from orbit_env.analysis.scenario import Scenario
-from orbit_env.checks import check_number
+from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario
+from orbit_env.checks import check_date, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
-from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, integrate_reference, propagate
+from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate, reference_path
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
@@ -32,6 +32,18 @@ METHODS: tuple[str, ...] = ("averaged", "curves", "direct")
 PAPER_SPHERE_DIAMETER_M = 0.5
 PAPER_SPHERE_MASS_KG = 10.0
 PAPER_DRAG_COEFFICIENT = 2.0
+
+#: Bounds of a satellite's drag properties, and why. Outside them a lifetime is a number of
+#: 300 digits or of 1e-300 days: no body in orbit has such values.
+DRAG_COEFFICIENT_RANGE = (0.0, 10.0, "free-molecular drag coefficients are 2 to 4 for any shape")
+MASS_RANGE_KG = (0.0, 1e6, "the largest satellite, the ISS, is 4.2e5 kg")
+AREA_RANGE_M2 = (0.0, 1e5, "a 300 m drag sail; the ISS spans about 2500 m^2")
+MASS_PER_AREA_RANGE_KG_M2 = (
+    0.01,
+    1e5,
+    "from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2",
+)
+DRAG_PARAMETER_RANGE_M2_KG = (1e-5, 1e3, "c_x A / m within the bounds of c_x and of mass / area")
 
 
 @dataclass(frozen=True)
@@ -49,16 +61,22 @@ class Satellite:
     area_m2: float = math.pi * (PAPER_SPHERE_DIAMETER_M / 2) ** 2
 
     def __post_init__(self) -> None:
-        check_number(self.drag_coefficient, "drag_coefficient", low=0.0, low_inclusive=False)
-        check_number(self.mass_kg, "mass_kg", unit="kg", low=0.0, low_inclusive=False)
-        check_number(self.area_m2, "area_m2", unit="m^2", low=0.0, low_inclusive=False)
+        for value, name, unit, (low, high, why) in (
+            (self.drag_coefficient, "drag_coefficient", "", DRAG_COEFFICIENT_RANGE),
+            (self.mass_kg, "mass_kg", "kg", MASS_RANGE_KG),
+            (self.area_m2, "area_m2", "m^2", AREA_RANGE_M2),
+        ):
+            check_number(value, name, unit=unit, low=low, high=high, low_inclusive=False, why=why)
+        low, high, why = MASS_PER_AREA_RANGE_KG_M2
+        check_number(self.mass_per_area_kg_m2, "mass_kg / area_m2", unit="kg/m^2", low=low, high=high, why=why)
 
     @classmethod
     def from_mass_per_area(
         cls, mass_per_area_kg_m2: float, drag_coefficient: float = PAPER_DRAG_COEFFICIENT
     ) -> Satellite:
         """A satellite given by its transverse load G/F [kg/m^2] (Eq. 4.1)."""
-        mass_kg = check_number(mass_per_area_kg_m2, "mass_per_area_kg_m2", unit="kg/m^2", low=0.0, low_inclusive=False)
+        low, high, why = MASS_PER_AREA_RANGE_KG_M2
+        mass_kg = check_number(mass_per_area_kg_m2, "mass_per_area_kg_m2", unit="kg/m^2", low=low, high=high, why=why)
         return cls(drag_coefficient=drag_coefficient, mass_kg=mass_kg, area_m2=1.0)
 
     @property
@@ -227,7 +245,8 @@ def lifetime(
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     hp_m, ha_m = (float(x) for x in validate_heights_km(perigee_km, apogee_km))
     satellite = satellite or Satellite()
-    scale = check_number(density_scale, "density_scale", low=0.0, low_inclusive=False)
+    low, high, why = DENSITY_SCALE_RANGE
+    scale = check_number(density_scale, "density_scale", low=low, high=high, why=why)
     if activity is not None or epoch is not None:
         if atmosphere is not None or rho100_kg_m3 is not None:
             raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
@@ -333,8 +352,8 @@ def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
     if epoch is None:
         return activity.start_days if isinstance(activity, TableActivity) else 0.0
     if not isinstance(epoch, str):
-        return check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD")
-    return unix_days(epoch)
+        return check_date(check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD"), "epoch")
+    return check_date(unix_days(epoch), "epoch", text=epoch)
 
 
 def _lifetime_under_activity(
@@ -346,10 +365,9 @@ def _lifetime_under_activity(
     c = satellite.drag_parameter_m2_kg
     per_nu = satellite.revolutions_per_nu
     if method == "averaged":
-        days = integrate_reference(hp_m, ha_m, c * scale, model)
+        t, hp_path, ha_path = reference_path(hp_m, ha_m, c * scale, model)
+        days = float(t[-1])
         reentered = days < model.max_years * 365.25
-        t = np.array([0.0, days])
-        hp_path, ha_path = np.array([hp_m, 100e3]), np.array([ha_m, np.nan])
     else:
         result = propagate(hp_m, ha_m, c, model, density_scale=scale, record=True)
         days, reentered = float(result.days[0]), bool(result.reentered[0])

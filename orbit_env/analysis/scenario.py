@@ -22,10 +22,13 @@ from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, Solar
 from orbit_env.decay.curves import UniversalCurves, universal_curves
 from orbit_env.decay.solar import ConstantActivity, CycleActivity, SolarActivity, TableActivity, iso_date
 from orbit_env.physics.atmosphere import Atmosphere, ExponentialAtmosphere, PaperAtmosphere
+from orbit_env.physics.atmosphere.exponential import ORBITAL_LAW
 
 FloatArray = NDArray[np.float64]
 AtmosphereKind = Literal["paper", "exponential", "msis"]
 ATMOSPHERES: tuple[str, ...] = ("paper", "exponential", "msis")
+#: Bounds of a density scale factor, and why.
+DENSITY_SCALE_RANGE = (1e-3, 1e3, "the models are off by a factor of a few at most; 1000 is another atmosphere")
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +39,8 @@ class Scenario:
         atmosphere: ``paper``, ``exponential`` or ``msis``.
         rho100_kg_m3: Paper law: density at 100 km (None: calibrated value).
         density_scale: Multiplier on any model's density.
-        rho0_kg_m3: Exponential law: density at ``h0_m``.
+        rho0_kg_m3: Exponential law: density at ``h0_m`` (default: the orbital-height law
+            :data:`~orbit_env.physics.atmosphere.exponential.ORBITAL_LAW`).
         h0_m: Exponential law: reference height.
         scale_height_m: Exponential law: scale height.
         activity: NRLMSIS: indices against time (default: F10.7 = 150, Ap = 15, constant).
@@ -51,9 +55,9 @@ class Scenario:
     atmosphere: AtmosphereKind = "paper"
     rho100_kg_m3: float | None = None
     density_scale: float = 1.0
-    rho0_kg_m3: float = 1.3
-    h0_m: float = 0.0
-    scale_height_m: float = 8.5e3
+    rho0_kg_m3: float = ORBITAL_LAW[0]
+    h0_m: float = ORBITAL_LAW[1]
+    scale_height_m: float = ORBITAL_LAW[2]
     activity: SolarActivity | None = None
     epoch_days: float | None = None
     rotating_atmosphere: bool = False
@@ -64,7 +68,8 @@ class Scenario:
     def __post_init__(self) -> None:
         if self.atmosphere not in ATMOSPHERES:
             raise ValueError(f"atmosphere must be one of {', '.join(ATMOSPHERES)}, got {self.atmosphere!r}")
-        check_number(self.density_scale, "density_scale", low=0.0, low_inclusive=False)
+        low, high, why = DENSITY_SCALE_RANGE
+        check_number(self.density_scale, "density_scale", low=low, high=high, why=why)
         if self.atmosphere != "msis" and (self.activity is not None or self.epoch_days is not None):
             raise ValueError("solar activity and epoch apply to the msis atmosphere only (use --atmosphere msis)")
         if self.atmosphere != "paper" and self.rho100_kg_m3 is not None:
@@ -137,9 +142,11 @@ class Scenario:
             assert isinstance(rho, PaperAtmosphere)
             return f"paper, rho(100 km) = {rho.rho100_kg_m3:.4g} kg/m^3{scale}"
         if self.atmosphere == "exponential":
+            law = (self.rho0_kg_m3, self.h0_m, self.scale_height_m)
+            default = " (the default law for orbital heights: Vallado 2013, Table 8-4)" if law == ORBITAL_LAW else ""
             return (
                 f"exponential, {self.rho0_kg_m3:.4g} kg/m^3 at {self.h0_m / 1e3:g} km, "
-                f"scale height {self.scale_height_m / 1e3:g} km{scale}"
+                f"scale height {self.scale_height_m / 1e3:g} km{scale}{default}"
             )
         solar = self.solar
         if isinstance(solar, ConstantActivity):

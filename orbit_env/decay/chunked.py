@@ -38,6 +38,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -328,6 +329,21 @@ def integrate_reference(
     linearly in time; dp/dt and de/dt are the averaged rates of
     :mod:`orbit_env.decay.averaged` times dnu/dt = g c / P. Slow: ~25 ms per profile.
     """
+    solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
+    if solution.status != 1:
+        return model.max_years * 365.25
+    return float(solution.t_events[0][0]) / SECONDS_PER_DAY
+
+
+def _solve_reference(
+    perigee_m: float,
+    apogee_m: float,
+    drag_parameter_m2_kg: float,
+    model: SolarDecayModel,
+    profile_step_days: float,
+    rtol: float,
+) -> Any:
+    """The ``solve_ivp`` solution behind :func:`integrate_reference` and :func:`reference_path`."""
     profiles: dict[int, FloatArray] = {}
 
     def log_profile(index: int) -> FloatArray:
@@ -372,6 +388,26 @@ def integrate_reference(
         atol=[1e-3, 1e-12],
         max_step=profile_step_days * SECONDS_PER_DAY,
     )
-    if solution.status != 1:
-        return model.max_years * 365.25
-    return float(solution.t_events[0][0]) / SECONDS_PER_DAY
+    return solution
+
+
+def reference_path(
+    perigee_m: float,
+    apogee_m: float,
+    drag_parameter_m2_kg: float,
+    model: SolarDecayModel,
+    *,
+    profile_step_days: float = 1.0,
+    rtol: float = 1e-8,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The decay of :func:`integrate_reference` as it goes: days, perigee [m] and apogee [m] at its steps.
+
+    The last point is the re-entry (perigee 100 km), or the state at ``max_years``.
+    """
+    solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
+    t_s, states = solution.t, solution.y.T
+    if solution.status == 1:
+        t_s = np.append(t_s[t_s < solution.t_events[0][0]], solution.t_events[0][0])
+        states = np.vstack([states[: t_s.size - 1], solution.y_events[0][:1]])
+    perigee, apogee = heights_from_elements(states[:, 0], np.maximum(states[:, 1], 0.0))
+    return t_s / SECONDS_PER_DAY, np.asarray(perigee, dtype=np.float64), np.asarray(apogee, dtype=np.float64)
