@@ -12,6 +12,8 @@ needs nothing.
 
 from __future__ import annotations
 
+import os
+import sys
 from typing import Any
 
 import numpy as np
@@ -78,6 +80,36 @@ def background_curves() -> tuple[list[NDArray[np.float64]], list[NDArray[np.floa
     return decay, levels
 
 
+#: Matplotlib backends that draw into files or memory, never a window.
+FILE_BACKENDS = frozenset({"agg", "cairo", "pdf", "pgf", "ps", "svg", "template"})
+
+
+def check_window(backend: str) -> None:
+    """Refuse ``render_mode="human"`` where no window can open, saying what is missing.
+
+    Without a display matplotlib falls back to a backend that draws into memory, and a
+    "human" render would show nothing at all.
+
+    Args:
+        backend: Matplotlib's backend (``matplotlib.get_backend()``).
+
+    Raises:
+        RuntimeError: ``backend`` cannot open a window; the message names the backend,
+            the display variables (on Linux) and the render modes that need none.
+    """
+    name = backend.lower()
+    if name not in FILE_BACKENDS:
+        return
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        missing = "a display: neither DISPLAY nor WAYLAND_DISPLAY is set"
+    else:
+        missing = "an interactive matplotlib backend (MPLBACKEND or matplotlib.use, e.g. TkAgg or QtAgg)"
+    raise RuntimeError(
+        f"render_mode='human' opens a window, which needs {missing}, and matplotlib's backend is "
+        f"{backend!r}, which draws no window; use render_mode='rgb_array' (frames as arrays) or 'ansi' (text)"
+    )
+
+
 class TrackRenderer:
     """Draws a mission's track on the (apogee, perigee) plane.
 
@@ -93,9 +125,9 @@ class TrackRenderer:
         if human:
             import matplotlib.pyplot as plt
 
+            check_window(matplotlib.get_backend())
             self._plt = plt
             self.figure = plt.figure(figsize=FIGURE_SIZE_IN, dpi=FIGURE_DPI)
-            self._interactive = matplotlib.get_backend().lower() not in {"agg", "pdf", "ps", "svg", "cairo"}
         else:
             from matplotlib.backends.backend_agg import FigureCanvasAgg
             from matplotlib.figure import Figure
@@ -137,10 +169,7 @@ class TrackRenderer:
             self._axes.set_xlim(REENTRY_ALTITUDE_M / 1e3, max(1700.0, 1.05 * points[:, 0].max()))
         self._axes.set_title(f"t = {time_days:.1f} d, delta-v left {dv_left_m_s:.0f} m/s", fontsize=9)
         if self.human:
-            if self._interactive:
-                self._plt.pause(1.0 / self.fps)
-            else:
-                self.figure.canvas.draw()
+            self._plt.pause(1.0 / self.fps)
             return None
         canvas = self.figure.canvas
         canvas.draw()
