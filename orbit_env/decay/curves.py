@@ -196,11 +196,8 @@ class _Grid:
         j = int(fy)
         ty = fy - j
         txy = tx * ty
-        row = i * self.ny + j
-        item = self.cells.item
-        return [
-            item(row, m, 1) * tx + item(row, m, 0) + item(row, m, 2) * ty + item(row, m, 3) * txy for m in range(self.k)
-        ]
+        # The cell's coefficients as Python floats in one call (item() per number costs four times more).
+        return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[i * self.ny + j].tolist()]
 
 
 def _heights(mu: FloatArray, b0: FloatArray, b1: FloatArray, q: FloatArray) -> tuple[FloatArray, ...]:
@@ -520,7 +517,14 @@ def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike 
 
 def universal_curves(model: DecayModel | None = None) -> UniversalCurves:
     """The universal curves of ``model`` (default: the paper's), built once per process and kept on disk."""
-    return _curves_of(model or DecayModel())
+    if model is None:
+        return _default_curves()  # the envs ask for it every step: no DecayModel() built per call
+    return _curves_of(model)
+
+
+@lru_cache(maxsize=1)
+def _default_curves() -> UniversalCurves:
+    return _curves_of(DecayModel())
 
 
 @lru_cache(maxsize=8)
