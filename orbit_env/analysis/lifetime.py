@@ -251,7 +251,9 @@ def lifetime(
         if atmosphere is not None or rho100_kg_m3 is not None:
             raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
         if activity is None:
-            raise ValueError("an epoch needs a solar activity (e.g. ConstantActivity(f107, f107a, ap))")
+            from orbit_env.decay.solar_record import load_record
+
+            activity = load_record()  # a date and no activity: the observed and forecast Sun
         if isinstance(activity, ConstantActivity) and epoch is None:
             from orbit_env.physics.atmosphere.msis import MsisAtmosphere
 

@@ -151,6 +151,8 @@ class Scenario:
         solar = self.solar
         if isinstance(solar, ConstantActivity):
             what = f"F10.7 {solar.f107_sfu:g}, 81-day mean {solar.f107a_sfu:g} sfu, Ap {solar.ap:g}"
+        elif hasattr(solar, "describe"):
+            what = solar.describe()  # the space-weather record names its source and its eras
         elif isinstance(solar, TableActivity):
             what = f"solar table {solar.source} ({iso_date(solar.start_days)} to {iso_date(solar.end_days)})"
         elif isinstance(solar, CycleActivity):

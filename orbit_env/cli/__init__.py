@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 from orbit_env import cache
 from orbit_env.checks import InputError
-from orbit_env.cli import agents, lifetime, paper
+from orbit_env.cli import agents, lifetime, paper, solar
 from orbit_env.cli.common import FLAGS, PROG, Parser, in_flags
 
 __all__ = ["FLAGS", "PROG", "build_parser", "main"]
@@ -27,6 +27,7 @@ def build_parser() -> Parser:
     lifetime.add_parsers(sub)
     paper.add_parsers(sub)
     agents.add_parsers(sub)
+    solar.add_parsers(sub)
     for command in sub.choices.values():
         command.add_argument(
             "--no-cache",

@@ -77,6 +77,11 @@ def _scenario(args: argparse.Namespace) -> Scenario:
         if epoch is None:
             raise ValueError("--solar-cycle needs --epoch (the orbit's date; it sets the phase and the season)")
         activity = CycleActivity() if args.cycle_phase is None else CycleActivity.with_phase(args.cycle_phase, epoch)
+    elif epoch is not None and args.f107 is None and args.f107a is None and args.ap is None:
+        # A real date and no other solar option: the real Sun (the shipped or imported record).
+        from orbit_env.decay.solar_record import load_record
+
+        activity = load_record()
     else:
         f107 = 150.0 if args.f107 is None else args.f107
         activity = ConstantActivity(

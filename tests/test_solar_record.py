@@ -1,0 +1,116 @@
+"""The shipped space-weather record: reading CelesTrak's file, the cycle repeated after it, the update command."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from orbit_env.cli import build_parser, main
+from orbit_env.cli.lifetime import _scenario
+from orbit_env.cli.orbit_inputs import prepare
+from orbit_env.decay.solar import read_solar_csv, unix_days
+from orbit_env.decay.solar_record import (
+    REPEAT_PERIOD_DAYS,
+    SHIPPED_RECORD,
+    RecordActivity,
+    load_record,
+    parse_celestrak,
+    read_record,
+)
+
+DOCS_TABLE = Path(__file__).resolve().parent.parent / "docs" / "data" / "solar_daily_1995_2018.csv"
+
+
+def sw_line(date, f107_obs, ctr81, ap):
+    """One OBSERVED row in CelesTrak's column layout (only the columns read here matter)."""
+    y, m, d = date.split("-")
+    kp = " ".join(["10"] * 8)
+    aps = " ".join([f"{ap:3d}"] * 8)
+    f107 = f"{f107_obs:5.1f} 0 {ctr81:5.1f} 100.0 {f107_obs:5.1f} {ctr81:5.1f} 100.0"
+    return f"{y} {m} {d} 2500  1 {kp}  80 {aps} {ap:3d} 0.5 2 100 {f107}"
+
+
+def sw_file(tmp_path, observed, monthly=(), updated="2030 Jan 01 00:00:00 UTC", name="SW-All.txt"):
+    lines = ["DATATYPE CssiSpaceWeather", f"UPDATED {updated}", "BEGIN OBSERVED"]
+    lines += [sw_line(*row) for row in observed]
+    lines += ["END OBSERVED", "BEGIN MONTHLY_PREDICTED"]
+    for date, f107, ctr in monthly:
+        y, m = date.split("-")
+        lines.append(
+            f"{y} {m} 01 2600  1" + " " * 70 + f"100 {f107 + 2:5.1f}   {ctr:5.1f} 100.0 {f107:5.1f} {ctr:5.1f} 100.0"
+        )
+    lines += ["END MONTHLY_PREDICTED"]
+    path = tmp_path / name
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_shipped_record_matches_the_validation_table_day_by_day():
+    # docs/data/solar_daily_1995_2018.csv was extracted from the same CelesTrak file for the validation page
+    # (previous day's observed F10.7, centred 81-day mean, daily Ap): the two readings must agree exactly.
+    table = read_solar_csv(DOCS_TABLE)
+    record = read_record(SHIPPED_RECORD)
+    f107, f107a, ap = record.indices(table.days)
+    np.testing.assert_array_equal(f107, table.f107_sfu)
+    np.testing.assert_array_equal(f107a, table.f107a_sfu)
+    np.testing.assert_array_equal(ap, table.ap)
+    assert record.start_days == unix_days("1957-10-01")
+    assert SHIPPED_RECORD.stat().st_size < 500_000  # package data stays small
+
+
+def test_parsing_shifts_bursts_and_fills_the_forecast(tmp_path):
+    observed = [("2020-01-01", 70.0, 71.0, 5), ("2020-01-02", 450.0, 72.0, 9), ("2020-01-03", 74.0, 73.0, 7)]
+    record = parse_celestrak(sw_file(tmp_path, observed, monthly=[("2020-03", 90.0, 88.0)]))
+    days = [unix_days(d) for d in ("2020-01-01", "2020-01-02", "2020-01-03", "2020-01-04")]
+    f107, f107a, ap = record.indices(days[:3])
+    # F10.7 of the previous day (the first day keeps its own); the 450 sfu burst becomes its 81-day mean 72.
+    assert list(f107) == [70.0, 70.0, 72.0]
+    assert list(f107a) == [71.0, 72.0, 73.0] and list(ap) == [5.0, 9.0, 7.0]
+    # The monthly forecast sits on the 15th, its observed F10.7 column; its Ap is the Ap one period earlier
+    # (before the record: the first row, held).
+    f107, f107a, ap = record.indices([unix_days("2020-03-15")])
+    assert (f107[0], f107a[0], ap[0]) == (90.0, 88.0, 5.0)
+    assert record.observed_end_days == days[2] and record.era(days[3]) == "forecast"
+
+
+def test_after_the_forecast_the_last_cycle_repeats():
+    record = load_record()
+    t = record.end_days + np.array([1.0, 400.0, 3000.0, REPEAT_PERIOD_DAYS + 10.0])
+    for now, then in zip(record.indices(t), record.indices(t - REPEAT_PERIOD_DAYS), strict=True):
+        np.testing.assert_array_equal(now, then)
+    assert record.era(float(t[0])) == "repeated cycle"
+    assert REPEAT_PERIOD_DAYS == 4017.0  # cycle 24: minimum December 2008 to minimum December 2019
+
+
+def test_solar_update_merges_a_newer_file_and_refuses_an_older(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("ORBIT_ENV_DATA_DIR", str(tmp_path / "data"))
+    shipped = read_record(SHIPPED_RECORD)
+    end = shipped.observed_end_days
+    newer = [(str(np.datetime64(int(end) + k, "D")), 150.0 + k, 140.0, 20) for k in (-1, 0, 1, 2)]
+    path = sw_file(tmp_path, newer, updated="2099 Jan 01 00:00:00 UTC", name="SW-Last5Years.txt")
+    assert main(["solar", "update", str(path)]) == 0
+    assert "imported" in capsys.readouterr().out
+    record = load_record()
+    assert record.observed_end_days == end + 2 and record.updated == "2099 Jan 01 00:00:00 UTC"
+    assert record.files.endswith("+ SW-Last5Years.txt")
+    # The rows before the new file's first day are the shipped ones; the new file's replace the rest.
+    early = shipped.start_days + np.arange(0.0, 1000.0)
+    np.testing.assert_array_equal(record.indices(early)[0], shipped.indices(early)[0])
+    assert record.indices([end + 2])[0][0] == 151.0  # the previous day's 151
+    old = sw_file(tmp_path, [("1990-01-01", 70.0, 71.0, 5)], name="old.txt")
+    assert main(["solar", "update", str(old)]) == 2
+    assert "before the shipped record's" in capsys.readouterr().err
+
+
+def test_an_epoch_alone_means_nrlmsis_and_the_real_sun():
+    args = build_parser().parse_args(["lifetime", "--perigee", "400", "--apogee", "400", "--epoch", "2003-10-01"])
+    prepare(args)
+    scenario = _scenario(args)
+    assert scenario.atmosphere == "msis" and isinstance(scenario.activity, RecordActivity)
+    # The Halloween storms of 2003: Ap 204 on 29 October (CelesTrak's record; a figure widely quoted).
+    assert scenario.activity.indices([unix_days("2003-10-29")])[2][0] == pytest.approx(204.0)
+    args = build_parser().parse_args(
+        ["lifetime", "--perigee", "400", "--apogee", "400", "--epoch", "2003-10-01", "--f107", "100"]
+    )
+    prepare(args)
+    assert not isinstance(_scenario(args).activity, RecordActivity)
