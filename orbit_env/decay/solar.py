@@ -26,7 +26,6 @@ a monthly mean and the computed ``f107a`` a ~3-month mean).
 
 from __future__ import annotations
 
-import csv
 import datetime as _dt
 import math
 from dataclasses import dataclass, field
@@ -37,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import InputError, check_array, check_number, format_number
+from orbit_env.csvfile import read_csv
 from orbit_env.physics.atmosphere.msis import AP_RANGE, F107_RANGE_SFU
 
 FloatArray = NDArray[np.float64]
@@ -45,6 +45,8 @@ FloatArray = NDArray[np.float64]
 F107A_WINDOW_DAYS = 81
 #: Default daily Ap where none is given (near the long-term median of daily Ap).
 DEFAULT_AP = 12.0
+#: Dates a solar table may hold: daily F10.7 is measured since 1947; no use here reaches past 2200.
+SOLAR_TABLE_DATES = ("1947-01-01", "2200-12-31")
 #: Mean length of the solar cycle [days] (11.0 years).
 SOLAR_CYCLE_DAYS = 11.0 * 365.25
 
@@ -184,38 +186,52 @@ def read_solar_csv(path: str | Path, default_ap: float = DEFAULT_AP) -> TableAct
             order, or indices out of range; the message names the file and row.
         OSError: the file cannot be read.
     """
-    source = str(path)
-    with open(path, newline="") as handle:
-        reader = csv.DictReader(handle)
-        columns = [name.strip().lower() for name in (reader.fieldnames or [])]
-        for required in ("date", "f107"):
-            if required not in columns:
-                raise ValueError(f"{source}: the solar table needs a '{required}' column, found {columns}")
-        rows = [{key.strip().lower(): (value or "").strip() for key, value in row.items() if key} for row in reader]
-    if not rows:
-        raise ValueError(f"{source}: the solar table has no rows")
-    days = np.empty(len(rows))
-    f107 = np.empty(len(rows))
-    f107a = np.full(len(rows), np.nan)
-    ap = np.full(len(rows), float(default_ap))
-    for i, row in enumerate(rows):
-        line = i + 2
+    table = read_csv(path)
+    source = table.source
+    table.require("date", "f107", what="the solar table")
+    if not table.rows:
+        raise ValueError(f"{source}: the solar table has a header but no rows")
+    n = len(table.rows)
+    days = np.empty(n)
+    f107 = np.empty(n)
+    f107a = np.full(n, np.nan)
+    ap = np.full(n, float(default_ap))
+    first, last = unix_days(SOLAR_TABLE_DATES[0]), unix_days(SOLAR_TABLE_DATES[1])
+    for i, row in enumerate(table.rows):
+        cells = row.cells
         try:
-            days[i] = unix_days(row["date"])
-            f107[i] = float(row["f107"])
-            if row.get("f107a"):
-                f107a[i] = float(row["f107a"])
-            if row.get("ap"):
-                ap[i] = float(row["ap"])
+            if row.extra:
+                raise ValueError(f"more cells than the header has columns (extra: {', '.join(row.extra)[:40]})")
+            days[i] = unix_days(cells["date"])
+            if not first <= days[i] <= last:
+                raise ValueError(
+                    f"date={cells['date']!r} is out of range; allowed: {SOLAR_TABLE_DATES[0]} to "
+                    f"{SOLAR_TABLE_DATES[1]} (F10.7 is measured since 1947)"
+                )
+            f107[i] = check_number(_cell(cells["f107"]), "f107", unit="sfu")
+            if cells.get("f107a"):
+                f107a[i] = check_number(_cell(cells["f107a"]), "f107a", unit="sfu")
+            if cells.get("ap"):
+                ap[i] = check_number(_cell(cells["ap"]), "ap")
         except ValueError as error:
-            raise ValueError(f"{source}, line {line}: {error}") from None
-    order_ok = np.all(np.diff(days) > 0)
-    if not order_ok:
-        raise ValueError(f"{source}: dates must be strictly increasing")
+            raise ValueError(f"{row.where(source)}: {error}") from None
+    for i in np.flatnonzero(np.diff(days) <= 0):
+        raise ValueError(
+            f"{table.rows[i + 1].where(source)}: the date is not after line {table.rows[i].line}'s; "
+            "dates must be strictly increasing"
+        )
     missing = np.isnan(f107a)
     if missing.any():
         f107a[missing] = centred_mean(days, f107)[missing]
     return TableActivity(days, f107, f107a, ap, source=source)
+
+
+def _cell(text: str) -> float | str:
+    """A cell as a float, or the text itself (which check_number then refuses by name)."""
+    try:
+        return float(text)
+    except ValueError:
+        return text if text else "(empty)"
 
 
 def _cycle_shape(phase: FloatArray, peak_phase: float) -> FloatArray:
