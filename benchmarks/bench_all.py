@@ -1,0 +1,140 @@
+"""Every speed target where users wait, as ratios against references measured in the same run.
+
+One command (``python benchmarks/bench_all.py``) prints:
+
+1. start-up, whole processes (medians of ``--repeats``), against ``python -c "import numpy"``:
+   ``orbit-env --help``; a lifetime by the default method; a lifetime through the universal
+   curves with the disk cache warm and with it off (the curves built);
+2. ``orbit-env table2`` from scratch (``--no-cache``), whole process, against a naive numpy
+   RK4 of the averaged model, cell by cell (a whole process too);
+3. ``orbit-env evaluate`` (1000 episodes): wall time and peak memory;
+4. the environments against Gymnasium's CartPole: ``benchmarks/bench_env.py`` (single env
+   through ``gymnasium.make`` and the vector env at 4096 envs), and Gymnasium's own
+   ``gymnasium.utils.performance.benchmark_step`` for every registered id.
+
+The machine is stated at the top. The disk cache is pointed at a temporary folder,
+so the user's cache is neither read nor changed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+#: The naive reference of item 2: RK4 in p with a fixed step, one Table II cell after the other.
+NAIVE_TABLE2 = """
+import numpy as np
+from orbit_env.decay.averaged import DecayModel
+from orbit_env.constants import EARTH_RADIUS_M, REENTRY_ALTITUDE_M
+from orbit_env.paper.table2 import load_table2
+from orbit_env.physics.orbit import elements_from_heights
+
+model = DecayModel()
+table = load_table2()
+STEP_M = {step_m}
+nus = []
+for hp_km, ha_km in zip(table.perigee_km, table.apogee_km):
+    p, e = (float(x) for x in elements_from_heights(hp_km * 1e3, ha_km * 1e3))
+    nu = 0.0
+
+    def f(p, e):
+        dp_dnu, de_dnu = model.rates_per_nu(p, max(e, 0.0))
+        return float(de_dnu / dp_dnu), float(1.0 / dp_dnu)
+
+    while p / (1.0 + e) - EARTH_RADIUS_M > REENTRY_ALTITUDE_M:
+        h = -STEP_M
+        k1 = f(p, e)
+        k2 = f(p + h / 2, e + h / 2 * k1[0])
+        k3 = f(p + h / 2, e + h / 2 * k2[0])
+        k4 = f(p + h, e + h * k3[0])
+        e += h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        nu += h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        p += h
+    nus.append(nu)
+print(len(nus), float(np.median(nus)))
+"""
+
+
+def wall(command: list[str], repeats: int, env: dict[str, str]) -> float:
+    """Median wall time of a whole process [s]."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        subprocess.run(command, check=True, capture_output=True, env=env)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def main() -> None:
+    """Run every benchmark and print its ratio."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5, help="runs per whole-process timing (median)")
+    parser.add_argument("--skip-env", action="store_true", help="leave out item 4 (the environments)")
+    args = parser.parse_args()
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {sys.version.split()[0]}"
+    )
+    folder = tempfile.mkdtemp(prefix="orbit-env-bench-")
+    env = {**os.environ, "ORBIT_ENV_CACHE_DIR": folder}
+    python, cli = sys.executable, [sys.executable, "-m", "orbit_env.cli"]
+    repeats = args.repeats
+
+    # 1. Start-up.
+    numpy_s = wall([python, "-c", "import numpy"], repeats, env)
+    print(f"1. start-up (whole processes, medians of {repeats}); reference python -c 'import numpy': {numpy_s:.3f} s")
+    orbit = ["lifetime", "--perigee", "360", "--apogee", "800"]
+    subprocess.run([*cli, *orbit, "--method", "curves"], check=True, capture_output=True, env=env)  # warm the cache
+    for label, command in (
+        ("orbit-env --help", [*cli, "--help"]),
+        ("a lifetime, default method", [*cli, *orbit]),
+        ("a lifetime through the curves, cache warm", [*cli, *orbit, "--method", "curves"]),
+        ("a lifetime through the curves, no cache", [*cli, *orbit, "--method", "curves", "--no-cache"]),
+    ):
+        seconds = wall(command, repeats, env)
+        print(f"   {label:<44} {seconds:6.3f} s  ratio {seconds / numpy_s:5.2f}x import numpy")
+
+    # 2. Table II from scratch against the naive RK4.
+    table_s = wall([*cli, "table2", "--no-cache"], repeats, env)
+    naive_s = wall([python, "-c", NAIVE_TABLE2.format(step_m=2000.0)], 1, env)
+    print(
+        f"2. orbit-env table2 --no-cache {table_s:.3f} s; naive numpy RK4 (2 km steps in p, cell by cell) {naive_s:.2f} s"
+    )
+    print(f"   ratio {naive_s / table_s:.1f}x")
+
+    # 3. The main job.
+    start = time.perf_counter()
+    subprocess.run([*cli, "evaluate"], check=True, capture_output=True, env=env)
+    evaluate_s = time.perf_counter() - start
+    peak_mb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024  # the largest child so far
+    print(f"3. orbit-env evaluate (1000 episodes): {evaluate_s:.1f} s, peak memory {peak_mb:.0f} MB")
+
+    if args.skip_env:
+        return
+    # 4. The environments.
+    print("4. environments against CartPole (benchmarks/bench_env.py)")
+    subprocess.run([python, str(HERE / "bench_env.py")], check=True, env=env)
+    print("   gymnasium.utils.performance.benchmark_step (random actions, 3 s each)")
+    code = (
+        "import gymnasium as gym, orbit_env\n"
+        "from gymnasium.utils.performance import benchmark_step\n"
+        "ref = benchmark_step(gym.make('CartPole-v1'), target_duration=3)\n"
+        "print(f'   CartPole-v1 {ref:12,.0f} steps/s')\n"
+        "for env_id in orbit_env.envs.ENV_IDS:\n"
+        "    rate = benchmark_step(gym.make(env_id), target_duration=3)\n"
+        "    print(f'   {env_id:<27} {rate:12,.0f} steps/s  ratio {rate / ref:.2f}x')\n"
+    )
+    subprocess.run([python, "-c", code], check=True, env=env)
+
+
+if __name__ == "__main__":
+    main()
