@@ -81,9 +81,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5, help="runs per whole-process timing (median)")
     parser.add_argument("--skip-env", action="store_true", help="leave out item 4 (the environments)")
     args = parser.parse_args()
-    print(
-        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {sys.version.split()[0]}"
-    )
+    machine = platform.processor() or platform.machine()
+    print(f"machine: {machine}, {os.cpu_count()} cores, Python {sys.version.split()[0]}")
     folder = tempfile.mkdtemp(prefix="orbit-env-bench-")
     env = {**os.environ, "ORBIT_ENV_CACHE_DIR": folder}
     python, cli = sys.executable, [sys.executable, "-m", "orbit_env.cli"]
@@ -106,9 +105,7 @@ def main() -> None:
     # 2. Table II from scratch against the naive RK4.
     table_s = wall([*cli, "table2", "--no-cache"], repeats, env)
     naive_s = wall([python, "-c", NAIVE_TABLE2.format(step_m=2000.0)], 1, env)
-    print(
-        f"2. orbit-env table2 --no-cache {table_s:.3f} s; naive numpy RK4 (2 km steps in p, cell by cell) {naive_s:.2f} s"
-    )
+    print(f"2. orbit-env table2 --no-cache {table_s:.3f} s; naive numpy RK4 (2 km steps, per cell) {naive_s:.2f} s")
     print(f"   ratio {naive_s / table_s:.1f}x")
 
     # 3. The main job.
