@@ -33,10 +33,13 @@ def test_poliastro_drag_test_48_2_days():
 
 def test_cli_exponential_matches_the_api(capsys):
     argv = ["lifetime", "--perigee", "230", "--apogee", "230", "--atmosphere", "exponential", "--cx", "2.2"]
-    status, out, _ = run(capsys, *argv, "--mass", "100", "--area", str(math.pi / 4), "--json")
+    law = ["--rho0", "1.3", "--h0-km", "0", "--scale-height-km", "8.5"]  # poliastro's sea-level law
+    status, out, _ = run(capsys, *argv, *law, "--mass", "100", "--area", str(math.pi / 4), "--json")
     assert status == 0
     assert json.loads(out)["days"] == pytest.approx(48.2, rel=0.02)
-    status, out, _ = run(capsys, *argv, "--mass", "100", "--area", "0.785", "--rho0", "1.3", "--scale-height-km", "17")
+    status, out, _ = run(
+        capsys, *argv, "--mass", "100", "--area", "0.785", "--rho0", "1.3", "--h0-km", "0", "--scale-height-km", "17"
+    )
     assert status == 0 and "scale height 17 km" in out
 
 
@@ -120,8 +123,12 @@ def test_batch_matches_single_lifetimes_and_reports_bad_rows(capsys, tmp_path):
         handle.write("e,abc,300,100,1,\n")
         handle.write("f,350,360,,,\n")  # the CLI's satellite
     out = tmp_path / "out.csv"
-    status, stdout, _ = run(capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress", "--cx", "2.2")
-    assert status == 0 and "6 rows" in stdout and "3 with lifetimes" in stdout
+    status, stdout, err = run(
+        capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress", "--cx", "2.2"
+    )
+    # Exit status 1: the file is complete, but 3 rows have no lifetime (one line on stderr says so).
+    assert status == 1 and "6 rows" in stdout and "3 with lifetimes" in stdout
+    assert err.startswith("orbit-env: 3 of 6 rows have no lifetime (first: line 4: ") and err.count("\n") == 1
     records = list(csv.DictReader(open(out)))
     assert [r["name"] for r in records] == ["a", "b", "c", "d", "e", "f"]
     expected = {
@@ -156,10 +163,12 @@ def test_batch_rows_with_bad_numbers_name_the_column_and_the_cell(capsys, tmp_pa
     )
     out = tmp_path / "out.csv"
     status, stdout, _ = run(capsys, "lifetime", "--batch", str(sats), "--out", str(out), "--no-progress")
-    assert status == 0 and "6 rows" in stdout and "1 with lifetimes" in stdout
+    assert status == 1 and "6 rows" in stdout and "1 with lifetimes" in stdout
     assert [record["status"] for record in csv.DictReader(open(out))] == [
-        "line 2: mass_kg=0 is out of range; allowed: above 0 kg",
-        "line 3: mass_per_area_kg_m2=0 is out of range; allowed: above 0 kg/m^2",
+        "line 2: mass_kg=0 is out of range; allowed: above 0 and at most 1000000 kg "
+        "(the largest satellite, the ISS, is 4.2e5 kg)",
+        "line 3: mass_per_area_kg_m2=0 is out of range; allowed: 0.01 to 100000 kg/m^2 "
+        "(from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2)",
         "line 4: inclination_deg=200 is out of range; allowed: 0 to 180 deg",
         "line 5: apogee_km=nan is not a finite number; allowed: a finite number",
         "line 6: perigee_km=90 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)",

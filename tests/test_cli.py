@@ -105,6 +105,8 @@ def test_bad_input_is_one_line_and_exit_2(capsys, argv):
 
 
 _ORBIT = ["lifetime", "--perigee", "400", "--apogee", "400"]
+#: A complete exponential law (the three values go together): poliastro's sea-level law.
+_LAW = ["--rho0", "1.3", "--h0-km", "0"]
 
 
 @pytest.mark.parametrize(
@@ -124,16 +126,18 @@ _ORBIT = ["lifetime", "--perigee", "400", "--apogee", "400"]
             "(the universal curves end there; the averaged ODE goes higher)",
         ),
         (
-            [*_ORBIT, "--atmosphere", "exponential", "--scale-height-km", "-8.5"],
-            "--scale-height-km -8.5 is out of range; allowed: above 0 km",
+            [*_ORBIT, "--atmosphere", "exponential", *_LAW, "--scale-height-km", "-8.5"],
+            "--scale-height-km -8.5 is out of range; allowed: 1 to 500 km "
+            "(the air's scale height runs from 6 km near the ground to 100 km at 1000 km)",
         ),
         (
-            [*_ORBIT, "--atmosphere", "exponential", "--rho0", "-1"],
-            "--rho0 -1 is out of range; allowed: above 0 kg/m^3",
+            [*_ORBIT, "--atmosphere", "exponential", "--rho0", "-1", "--h0-km", "0", "--scale-height-km", "8.5"],
+            "--rho0 -1 is out of range; allowed: above 0 and at most 10 kg/m^3 (air at sea level is 1.2 kg/m^3)",
         ),
         (
-            [*_ORBIT, "--atmosphere", "exponential", "--h0-km", "inf"],
-            "--h0-km inf is not a finite number; allowed: a finite number",
+            [*_ORBIT, "--atmosphere", "exponential", "--rho0", "1.3", "--h0-km", "inf", "--scale-height-km", "8.5"],
+            "--h0-km inf is not a finite number; allowed: 0 to 2000 km "
+            "(from sea level to the top of the orbits computed here)",
         ),
         (
             [*_ORBIT, "--atmosphere", "msis", "--inclination", "200"],
@@ -149,12 +153,32 @@ _ORBIT = ["lifetime", "--perigee", "400", "--apogee", "400"]
             [*_ORBIT, "--atmosphere", "msis", "--solar-cycle", "--epoch", "2020-01-01", "--cycle-phase", "1.5"],
             "--cycle-phase 1.5 is out of range; allowed: 0 to 1",
         ),
-        ([*_ORBIT, "--mass", "0", "--area", "1"], "--mass 0 is out of range; allowed: above 0 kg"),
-        ([*_ORBIT, "--mass", "10", "--area", "0.0"], "--area 0.0 is out of range; allowed: above 0 m^2"),
-        ([*_ORBIT, "--mass-per-area", "0"], "--mass-per-area 0 is out of range; allowed: above 0 kg/m^2"),
-        ([*_ORBIT, "--cx", "-1"], "--cx -1 is out of range; allowed: above 0"),
+        (
+            [*_ORBIT, "--mass", "0", "--area", "1"],
+            "--mass 0 is out of range; allowed: above 0 and at most 1000000 kg "
+            "(the largest satellite, the ISS, is 4.2e5 kg)",
+        ),
+        (
+            [*_ORBIT, "--mass", "10", "--area", "0.0"],
+            "--area 0.0 is out of range; allowed: above 0 and at most 100000 m^2 "
+            "(a 300 m drag sail; the ISS spans about 2500 m^2)",
+        ),
+        (
+            [*_ORBIT, "--mass-per-area", "0"],
+            "--mass-per-area 0 is out of range; allowed: 0.01 to 100000 kg/m^2 "
+            "(from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2)",
+        ),
+        (
+            [*_ORBIT, "--cx", "-1"],
+            "--cx -1 is out of range; allowed: above 0 and at most 10 "
+            "(free-molecular drag coefficients are 2 to 4 for any shape)",
+        ),
         ([*_ORBIT, "--rho100", "-3"], "--rho100 -3 is out of range; allowed: above 0 kg/m^3"),
-        ([*_ORBIT, "--density-scale", "0"], "--density-scale 0 is out of range; allowed: above 0"),
+        (
+            [*_ORBIT, "--density-scale", "0"],
+            "--density-scale 0 is out of range; allowed: 0.001 to 1000 "
+            "(the models are off by a factor of a few at most; 1000 is another atmosphere)",
+        ),
         ([*_ORBIT, "--rule", "0"], "--rule 0 is out of range; allowed: above 0 years"),
     ],
 )
@@ -181,7 +205,7 @@ def test_fit_density_names_the_bad_observation(capsys, tmp_path):
     status, _, err = run(capsys, "fit-density", str(observations))
     assert status == 2
     assert err == (
-        f"orbit-env: error: {observations}, observation 2: apogee_km=290 is out of range; "
+        f"orbit-env: error: {observations}, line 3: apogee_km=290 is out of range; "
         "allowed: perigee_km (300) to 50000 km\n"
     )
 
@@ -194,7 +218,10 @@ def test_the_api_names_its_parameters_in_its_units():
     )
     with pytest.raises(ValueError) as info:
         lifetime(300, 400, density_scale=-1)
-    assert str(info.value) == "density_scale=-1 is out of range; allowed: above 0"
+    assert str(info.value) == (
+        "density_scale=-1 is out of range; allowed: 0.001 to 1000 "
+        "(the models are off by a factor of a few at most; 1000 is another atmosphere)"
+    )
     with pytest.raises(ValueError) as info:
         lifetime(300, 400, inclination_deg=np.float64(-150.0))
     assert str(info.value) == "inclination_deg=-150 is out of range; allowed: 0 to 180 deg"
@@ -223,10 +250,17 @@ def test_lifetime_rises_with_perigee(perigee_km, extra_km, step_km):
 
 
 def test_satellite_validation():
-    with pytest.raises(ValueError, match=r"^mass_kg=0 is out of range; allowed: above 0 kg$"):
+    with pytest.raises(ValueError, match=r"^mass_kg=0 is out of range; allowed: above 0 and at most 1000000 kg \("):
         Satellite(mass_kg=0)
-    with pytest.raises(ValueError, match=r"^area_m2=nan is not a finite number; allowed: above 0 m\^2$"):
+    with pytest.raises(
+        ValueError, match=r"^area_m2=nan is not a finite number; allowed: above 0 and at most 100000 m\^2"
+    ):
         Satellite(area_m2=float("nan"))
+    # Each value within its bounds, but together a body denser than any: mass / area is bounded too.
+    with pytest.raises(
+        ValueError, match=r"^mass_kg / area_m2=100000000 is out of range; allowed: 0.01 to 100000 kg/m\^2"
+    ):
+        Satellite(mass_kg=1e5, area_m2=1e-3)
     with pytest.raises(ValueError, match=r"^drag_coefficient=True is not a number \(got a bool\)"):
         make_satellite(True)
     with pytest.raises(ValueError, match="not both"):

@@ -30,6 +30,8 @@ do not depend on it: one group.
 from __future__ import annotations
 
 import csv
+import os
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,8 +42,16 @@ from numpy.typing import NDArray
 from tqdm import tqdm
 
 from orbit_env.analysis.disposal import check_disposal_rule
+from orbit_env.analysis.lifetime import (
+    AREA_RANGE_M2,
+    DRAG_COEFFICIENT_RANGE,
+    DRAG_PARAMETER_RANGE_M2_KG,
+    MASS_PER_AREA_RANGE_KG_M2,
+    MASS_RANGE_KG,
+)
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
+from orbit_env.csvfile import read_csv
 from orbit_env.decay.curves import UniversalCurves
 
 FloatArray = NDArray[np.float64]
@@ -74,28 +84,33 @@ def _number(row: dict[str, str], key: str, **bounds: Any) -> float | None:
     return check_number(value, key, **bounds)
 
 
-def _positive(row: dict[str, str], key: str, unit: str = "") -> float | None:
-    return _number(row, key, unit=unit, low=0.0, low_inclusive=False)
+def _bounded(row: dict[str, str], key: str, unit: str, bounds: tuple[float, float, str]) -> float | None:
+    """The cell ``key`` within ``bounds`` (low, high, why; the satellite's bounds of the API)."""
+    low, high, why = bounds
+    return _number(row, key, unit=unit, low=low, high=high, low_inclusive=low > 0.0, why=why)
 
 
 def _drag_parameter(row: dict[str, str], default_cx: float, default_c: float) -> float:
-    cx = _positive(row, "cx")
+    cx = _bounded(row, "cx", "", DRAG_COEFFICIENT_RANGE)
     cx = default_cx if cx is None else cx
-    c = _positive(row, "drag_parameter_m2_kg", "m^2/kg")
-    load = _positive(row, "mass_per_area_kg_m2", "kg/m^2")
-    mass, area = _positive(row, "mass_kg", "kg"), _positive(row, "area_m2", "m^2")
+    c = _bounded(row, "drag_parameter_m2_kg", "m^2/kg", DRAG_PARAMETER_RANGE_M2_KG)
+    load = _bounded(row, "mass_per_area_kg_m2", "kg/m^2", MASS_PER_AREA_RANGE_KG_M2)
+    mass, area = _bounded(row, "mass_kg", "kg", MASS_RANGE_KG), _bounded(row, "area_m2", "m^2", AREA_RANGE_M2)
     if c is not None:
         value = c
     elif load is not None:
         value = cx / load
     elif mass is not None and area is not None:
+        low, high, why = MASS_PER_AREA_RANGE_KG_M2
+        check_number(mass / area, "mass_kg / area_m2", unit="kg/m^2", low=low, high=high, why=why)
         value = cx * area / mass
     elif mass is not None or area is not None:
         raise ValueError("give mass_kg and area_m2 together")
     else:
         value = default_c * (cx / default_cx)
-    # Positive factors give a positive c; only an overflow or underflow can spoil it.
-    return check_number(value, "drag parameter c_x A / m", unit="m^2/kg", low=0.0, low_inclusive=False)
+    # Factors within their bounds give c within its bounds; checked again in case of a new source.
+    low, high, why = DRAG_PARAMETER_RANGE_M2_KG
+    return check_number(value, "drag parameter c_x A / m", unit="m^2/kg", low=low, high=high, why=why)
 
 
 def read_batch(
@@ -107,20 +122,22 @@ def read_batch(
         ValueError: the header lacks ``perigee_km`` or ``apogee_km``, or there are no rows.
         OSError: the file cannot be read.
     """
-    with open(path, newline="") as handle:
-        reader = csv.DictReader(handle)
-        header = [name.strip().lower() for name in reader.fieldnames or []]
-        for required in ("perigee_km", "apogee_km"):
-            if required not in header:
-                raise ValueError(f"{path}: the batch file needs a '{required}' column, found {header}")
-        rows = [{(k or "").strip().lower(): (v or "").strip() for k, v in row.items()} for row in reader]
-    if not rows:
-        raise ValueError(f"{path}: the batch file has no rows")
+    table = read_csv(path)
+    table.require("perigee_km", "apogee_km", what="the batch file")
+    if not table.rows:
+        raise ValueError(f"{table.source}: the batch file has a header but no rows")
+    rows = [row.cells for row in table.rows]
+    lines = [row.line for row in table.rows]
     n = len(rows)
     hp_km, ha_km, c, inc = (np.full(n, np.nan) for _ in range(4))
     status = ["ok"] * n
-    for i, row in enumerate(rows):
+    for i, (row, record) in enumerate(zip(rows, table.rows, strict=True)):
         try:
+            if record.extra:
+                raise ValueError(
+                    f"{len(table.header) + len(record.extra)} cells, but the header has {len(table.header)} "
+                    f"columns (extra: {', '.join(record.extra)[:40]})"
+                )
             perigee, apogee = _number(row, "perigee_km"), _number(row, "apogee_km")
             if perigee is None or apogee is None:
                 raise ValueError("perigee_km and apogee_km are required")
@@ -130,7 +147,7 @@ def read_batch(
             c[i] = _drag_parameter(row, default_cx, default_c)
             inc[i] = inclination
         except ValueError as error:
-            status[i] = f"line {i + 2}: {error}"
+            status[i] = f"line {lines[i]}: {error}"
     # Heights in the curves' domain, checked a block at a time; a failing block row by row,
     # so every bad row gets its own message.
     readable = np.flatnonzero([s == "ok" for s in status])
@@ -142,7 +159,7 @@ def read_batch(
                 try:
                     UniversalCurves.check_domain_km(hp_km[i], ha_km[i])
                 except InputError as error:
-                    status[i] = f"line {i + 2}: {error}"
+                    status[i] = f"line {lines[i]}: {error}"
     return rows, hp_km * 1e3, ha_km * 1e3, c, inc, status
 
 
@@ -225,9 +242,55 @@ def _fmt(value: float) -> str:
     return "" if not np.isfinite(value) else f"{value:.6g}"
 
 
+def check_output(path: str | Path, input_path: str | Path, *, force: bool = False) -> None:
+    """Refuse, before any computing, an output that would replace the input, or an existing file, or cannot be written.
+
+    Args:
+        path: The results file.
+        input_path: The catalogue it is computed from.
+        force: Replace an existing results file (never the input).
+
+    Raises:
+        ValueError: ``path`` is the input file (also through a link), exists and
+            ``force`` is off, is a directory, or its directory is missing or not writable.
+    """
+    out, source = Path(path), Path(input_path)
+    if (out.exists() and source.exists() and os.path.samefile(out, source)) or out.resolve() == source.resolve():
+        raise ValueError(f"--out {path} is the input file; the results go to another file")
+    if out.is_dir():
+        raise ValueError(f"--out {path} is a directory; give a file name")
+    if out.exists() and not force:
+        raise ValueError(f"--out {path} exists; give --force to replace it, or another file name")
+    folder = out.parent
+    if not folder.is_dir():
+        raise ValueError(f"--out {path}: the folder {folder} does not exist")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as error:
+        raise ValueError(f"--out {path}: cannot write in {folder} ({error.strerror or error})") from None
+
+
 def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
-    """Write output records as CSV."""
-    with open(path, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(records[0]))
-        writer.writeheader()
-        writer.writerows(records)
+    """Write output records as CSV with LF line endings, atomically.
+
+    The rows go to a temporary file beside ``path``, renamed to ``path`` once
+    complete: a reader never sees half a file, and a failure leaves any earlier
+    file as it was.
+    """
+    out = Path(path)
+    handle = tempfile.NamedTemporaryFile(
+        "w", newline="", encoding="utf-8", dir=out.parent, prefix=f".{out.name}.", suffix=".tmp", delete=False
+    )
+    try:
+        with handle:
+            writer = csv.DictWriter(handle, fieldnames=list(records[0]), lineterminator="\n")
+            writer.writeheader()
+            writer.writerows(records)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(handle.name, 0o666 & ~umask)  # a temporary file is private; the results are not
+        os.replace(handle.name, out)
+    except BaseException:
+        Path(handle.name).unlink(missing_ok=True)
+        raise

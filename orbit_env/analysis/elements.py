@@ -227,6 +227,7 @@ def read_tle(path: str | Path) -> list[ElementSet]:
 
 def looks_like_tle(path: str | Path) -> bool:
     """Whether a file's first non-blank lines are an element set (rather than a CSV's header)."""
-    with open(path) as handle:
+    # A look only: bytes that are not text make no element set, and the CSV reader names the file.
+    with open(path, encoding="utf-8", errors="replace") as handle:
         lines = [line.rstrip() for line in handle.readlines()[:6] if line.strip()]
     return any(line.startswith("1 ") and len(line) == TLE_LINE_LENGTH for line in lines[:2])

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import math
 from typing import Any, NoReturn
 
 from orbit_env.checks import InputError
@@ -24,10 +25,24 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
 
+def check_finite(values: dict[str, Any], what: str) -> None:
+    """Refuse to output a NaN or an infinity: an error names the value, rather than a file or line holding it.
+
+    Raises:
+        ValueError: a float in ``values`` is not finite (a defect: the inputs were checked).
+    """
+    for key, value in values.items():
+        for number in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(number, float) and not math.isfinite(number):
+                raise ValueError(f"{what}: {key} came out as {number}; nothing written (a defect: please report it)")
+
+
 def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
-    """Write rows of equal keys to a CSV file with a header."""
+    """Write rows of equal keys to a CSV file with a header, LF line endings; never a NaN or an infinity."""
+    for row in rows:
+        check_finite(row, path)
     with open(path, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(handle, fieldnames=list(rows[0]), lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
 

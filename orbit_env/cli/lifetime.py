@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import sys
 import time
 from typing import Any
 
@@ -21,9 +23,19 @@ from orbit_env.analysis.lifetime import (
     make_satellite,
 )
 from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
+from orbit_env.checks import check_date
 from orbit_env.cli import orbit_inputs
-from orbit_env.cli.common import flag, given, number, write_csv
-from orbit_env.decay.solar import DEFAULT_AP, ConstantActivity, CycleActivity, SolarActivity, read_solar_csv, unix_days
+from orbit_env.cli.common import PROG, check_finite, flag, given, number, write_csv
+from orbit_env.decay.solar import (
+    DEFAULT_AP,
+    ConstantActivity,
+    CycleActivity,
+    SolarActivity,
+    TableActivity,
+    iso_date,
+    read_solar_csv,
+    unix_days,
+)
 from orbit_env.physics.atmosphere import ExponentialAtmosphere
 
 _MSIS_ONLY = ("f107", "f107a", "ap", "solar_csv", "solar_cycle", "cycle_phase", "epoch", "node_local_time")
@@ -49,11 +61,17 @@ def _scenario(args: argparse.Namespace) -> Scenario:
     if kind == "paper":
         return Scenario("paper", rho100_kg_m3=args.rho100, **common)
     if kind == "exponential":
-        exponential = ExponentialAtmosphere(
-            1.3 if args.rho0 is None else args.rho0,
-            0.0 if args.h0_km is None else args.h0_km * 1e3,
-            8.5e3 if args.scale_height_km is None else args.scale_height_km * 1e3,
-        )
+        typed = [args.rho0, args.h0_km, args.scale_height_km]
+        if any(value is None for value in typed) and any(value is not None for value in typed):
+            # A density from one law and a scale height from another make a third that nobody measured.
+            raise ValueError(
+                "give --rho0, --h0-km and --scale-height-km together (one law's three values), "
+                "or none for the orbital-height law"
+            )
+        if args.rho0 is None:
+            exponential = ExponentialAtmosphere()  # ORBITAL_LAW, named in the atmosphere line
+        else:
+            exponential = ExponentialAtmosphere(args.rho0, args.h0_km * 1e3, args.scale_height_km * 1e3)
         return Scenario(
             "exponential",
             rho0_kg_m3=exponential.rho0_kg_m3,
@@ -61,7 +79,7 @@ def _scenario(args: argparse.Namespace) -> Scenario:
             scale_height_m=exponential.scale_height_m,
             **common,
         )
-    epoch = None if args.epoch is None else unix_days(args.epoch)
+    epoch = None if args.epoch is None else check_date(unix_days(args.epoch), "--epoch", text=args.epoch)
     activity: SolarActivity
     if args.solar_csv and args.solar_cycle:
         raise ValueError("give either --solar-csv or --solar-cycle, not both")
@@ -97,7 +115,49 @@ def _satellite(args: argparse.Namespace) -> Satellite:
     return make_satellite(cx, args.mass, args.area, args.mass_per_area)
 
 
+def _atmosphere(args: argparse.Namespace, scenario: Scenario) -> str:
+    """The atmosphere line; says so when the inclination it depends on is the default, not the user's."""
+    text = scenario.describe(args.inclination)
+    depends = scenario.atmosphere == "msis" or scenario.rotating_atmosphere
+    if depends and getattr(args, "inclination_defaulted", False):
+        text += " (the default: no --inclination given)"
+    return text
+
+
+def _warn_solar_table(scenario: Scenario, last_day: float) -> None:
+    """Warn on stderr when a solar table does not cover the decay, from the epoch to ``last_day`` [unix days].
+
+    Outside its rows a table's first or last row is held (:class:`TableActivity`); the warning gives
+    the dates and says that this is what was done. Hook: once a shipped record and forecast can
+    extend a table, extend it in :func:`_scenario` and say so here instead.
+    """
+    solar = scenario.activity
+    if not isinstance(solar, TableActivity) or scenario.epoch_days is None or not math.isfinite(last_day):
+        return
+    held = []
+    if scenario.epoch_days < solar.start_days - 1.0:
+        held.append(f"starts on {iso_date(solar.start_days)}, after the epoch {iso_date(scenario.epoch_days)}")
+    if last_day > solar.end_days + 1.0:
+        held.append(
+            f"ends on {iso_date(solar.end_days)}, {last_day - solar.end_days:.0f} days before the re-entry on "
+            f"{iso_date(last_day)}"
+        )
+    if held:
+        print(
+            f"{PROG}: warning: the solar table {solar.source} {' and '.join(held)}; its edge rows were held "
+            "constant outside it (no record or forecast beyond the table is used)",
+            file=sys.stderr,
+        )
+
+
+def _json(summary: dict[str, Any]) -> str:
+    """One JSON object; NaN and infinities are refused here rather than printed (they are not JSON)."""
+    check_finite(summary, "the result")
+    return json.dumps(summary, allow_nan=False)
+
+
 def _cmd_lifetime(args: argparse.Namespace) -> int:
+    args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
     orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
     satellite, drag_source, drag_report = orbit_inputs.satellite_from_args(args, orbit, scenario)
@@ -105,6 +165,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         return _lifetime_batch(args, satellite, scenario)
     if args.out:
         raise ValueError("--out goes with --batch (a single lifetime prints; --trajectory writes its history)")
+    if args.force:
+        raise ValueError("--force goes with --batch --out (it lets the results replace an existing file)")
     if orbit.perigee_km is None or orbit.apogee_km is None:
         raise ValueError("give --perigee and --apogee, --semi-major-axis-km and --eccentricity, --tle, or --batch")
     perigee_km, apogee_km = orbit.sphere_heights_km
@@ -132,6 +194,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             chunk_days=args.chunk_days,
         )
     result = lifetime(perigee_km, apogee_km, **options)
+    if scenario.epoch_days is not None:
+        _warn_solar_table(scenario, scenario.epoch_days + result.days)
     summary = result.to_dict()
     summary.update(
         perigee_km=orbit.perigee_km,
@@ -167,12 +231,14 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
         plot_history(result, args.plot)
     if args.json:
-        print(json.dumps(summary))
+        summary["atmosphere"] = _atmosphere(args, scenario)
+        print(_json(summary))
         return 0
+    check_finite(summary, "the result")
     for line in orbit_inputs.orbit_lines(orbit, args.inclination):
         print(line)
     print(orbit_inputs.satellite_line(satellite, drag_source, drag_report))
-    print(f"atmosphere         {scenario.describe(args.inclination)}")
+    print(f"atmosphere         {_atmosphere(args, scenario)}")
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")
     print(f"lifetime           {result.days:.2f} days ({result.days / 365.25:.2f} years)")
@@ -190,7 +256,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
 
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
-    from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
+    from orbit_env.analysis.catalogue import batch_lifetimes, check_output, read_batch, write_records
 
     if not args.out:
         raise ValueError("--batch needs --out CSV for the results")
@@ -201,6 +267,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             raise ValueError(f"{flag(name)} applies to a single lifetime, not to --batch")
     if args.method is not None:
         raise ValueError("--batch always uses the universal curves; do not give --method")
+    check_output(args.out, args.batch, force=args.force)
     start = time.perf_counter()
     rows, hp, ha, c, inc, status = orbit_inputs.read_orbits(args, satellite, read_batch)
     records, summary = batch_lifetimes(
@@ -215,17 +282,31 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
         progress=not args.no_progress,
     )
     write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
+    if scenario.epoch_days is not None:
+        lived = [float(record["days"]) for record in records if record["days"]]
+        _warn_solar_table(scenario, scenario.epoch_days + max(lived, default=0.0))
     elapsed = time.perf_counter() - start
     print(
         f"wrote {summary.rows} rows to {args.out} ({summary.ok} with lifetimes, {summary.rows - summary.ok} with a "
-        f"status message) in {elapsed:.2f} s; atmosphere {scenario.describe(args.inclination)}"
+        f"status message) in {elapsed:.2f} s; atmosphere {_atmosphere(args, scenario)}"
     )
-    return 0
+    if summary.ok == summary.rows:
+        return 0
+    # Exit status 1: the results file is complete, but some rows have no lifetime (documented in
+    # docs/how-to/catalogue.md); one line on stderr says how many and the first reason.
+    first = next(record["status"] for record in records if record["status"] != "ok")
+    print(
+        f"{PROG}: {summary.rows - summary.ok} of {summary.rows} rows have no lifetime (first: {first}); "
+        f"the status column of {args.out} says why for each",
+        file=sys.stderr,
+    )
+    return 1
 
 
 def _cmd_fit_density(args: argparse.Namespace) -> int:
-    from orbit_env.analysis.density_fit import fit_density_scale, read_observations
+    from orbit_env.analysis.density_fit import fit_density_scale, read_observations, reentry_days
 
+    args.inclination_defaulted = args.inclination is None
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:
@@ -233,21 +314,25 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     satellite = _satellite(args)
     scenario = _scenario(args)
     observations = read_observations(args.observations)
+    reentry = None if args.reentry is None else reentry_days(args.reentry, observations, "--reentry")
     fit = fit_density_scale(
         observations,
         satellite=satellite,
         scenario=scenario,
         inclination_deg=args.inclination,
-        reentry=args.reentry,
+        reentry=reentry,
         reentry_sigma_days=args.reentry_sigma_days,
         height_sigma_km=args.height_sigma_km,
     )
+    if reentry is not None and scenario.epoch_days is not None:
+        _warn_solar_table(scenario, scenario.epoch_days + reentry - float(observations.days[0]))
     if args.json:
-        print(json.dumps(fit.to_dict()))
+        print(_json({**fit.to_dict(), "atmosphere": _atmosphere(args, scenario)}))
         return 0
+    check_finite(fit.to_dict(), "the fit")
     low68, high68 = fit.interval(0.68)
     low95, high95 = fit.interval(0.95)
-    print(f"atmosphere         {scenario.describe(args.inclination)}")
+    print(f"atmosphere         {_atmosphere(args, scenario)}")
     print(f"data               {fit.description}")
     print(f"density scale      {fit.scale:.4g} (68%: {low68:.4g} to {high68:.4g}; 95%: {low95:.4g} to {high95:.4g})")
     if fit.residual_rms_km is not None:
@@ -272,9 +357,11 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--rho100", type=number, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
     group.add_argument("--density-scale", type=number, default=1.0, help="multiply the density (default 1)")
-    group.add_argument("--rho0", type=number, metavar="KG_M3", help="exponential: density at --h0-km (default 1.3)")
-    group.add_argument("--h0-km", type=number, metavar="KM", help="exponential: reference height (default 0)")
-    group.add_argument("--scale-height-km", type=number, metavar="KM", help="exponential: scale height (default 8.5)")
+    group.add_argument(
+        "--rho0", type=number, metavar="KG_M3", help="exponential: density at --h0-km (all three, or none: orbital law)"
+    )
+    group.add_argument("--h0-km", type=number, metavar="KM", help="exponential: reference height (with --rho0)")
+    group.add_argument("--scale-height-km", type=number, metavar="KM", help="exponential: scale height (with --rho0)")
     group.add_argument("--f107", type=number, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
     group.add_argument("--f107a", type=number, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
     group.add_argument("--ap", type=number, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
@@ -312,6 +399,7 @@ def add_parsers(sub: Any) -> None:
         "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
     )
     life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
+    life.add_argument("--force", action="store_true", help="with --batch: replace an existing --out file")
     life.add_argument("--no-progress", action="store_true", help="with --batch: no progress bar")
     life.add_argument("--json", action="store_true", help="print one JSON object")
     life.add_argument("--trajectory", metavar="CSV", help="write the decay history to a CSV file")
@@ -320,7 +408,12 @@ def add_parsers(sub: Any) -> None:
 
     fit = sub.add_parser("fit-density", help="density scale factor from an observed decay (the paper's section 4)")
     fit.add_argument("observations", metavar="OBS_CSV", help="observed orbits: date (or days), perigee_km, apogee_km")
-    fit.add_argument("--reentry", metavar="DATE", help="observed re-entry date: fit it from the first orbit")
+    fit.add_argument(
+        "--reentry",
+        metavar="DATE|DAYS",
+        help="observed re-entry, on the observations' time axis (a date, or days with a 'days' column): "
+        "fit it from the first orbit",
+    )
     fit.add_argument("--reentry-sigma-days", type=number, default=0.5, help="uncertainty of --reentry (default 0.5)")
     fit.add_argument(
         "--height-sigma-km", type=number, default=1.0, help="with --reentry: uncertainty of the first orbit's heights"

@@ -1,0 +1,273 @@
+"""Bad input as a new user makes it: every row kept or explained, no silent nonsense, errors in the user's words."""
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from orbit_env.analysis import catalogue
+from orbit_env.analysis.lifetime import Satellite, lifetime
+from orbit_env.cli import main
+from orbit_env.cli.common import check_finite
+
+
+def run(capsys, *argv):
+    status = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+# ------------------------------------------------------------------------------------------
+# Batch: every good row computed and written; each bad row says which physical line it is.
+
+CATALOGUE = (
+    "name,perigee_km,apogee_km,mass_kg,area_m2\n"  # line 1
+    "good1,300,400,100,1\n"  # line 2
+    "\n"  # line 3: blank, still a line in an editor
+    "extra,300,400,100,1,surplus\n"  # line 4
+    "massless,300,400,0,1\n"  # line 5
+    "low,50,400,100,1\n"  # line 6
+    "text,abc,400,100,1\n"  # line 7
+    "good2,350,360,100,1\n"  # line 8
+)
+
+
+def test_batch_keeps_the_good_rows_and_names_the_bad_rows_lines(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_text(CATALOGUE)
+    out = tmp_path / "out.csv"
+    status, stdout, err = run(capsys, "lifetime", "--batch", sats, "--out", out, "--no-progress", "--cx", "2.2")
+    # Exit 1: the results are written, but 4 of the 6 rows have none.
+    assert status == 1
+    assert "wrote 6 rows" in stdout and "2 with lifetimes" in stdout
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("orbit-env: 4 of 6 rows have no lifetime (first: line 4: ")
+    records = list(csv.DictReader(open(out, newline="")))
+    assert [r["name"] for r in records] == ["good1", "extra", "massless", "low", "text", "good2"]
+    status_of = {r["name"]: r["status"] for r in records}
+    assert status_of["extra"].startswith("line 4: 6 cells, but the header has 5 columns")
+    assert status_of["massless"].startswith("line 5: mass_kg=0 is out of range")
+    assert status_of["low"].startswith("line 6: perigee_km=50 is out of range; allowed: 100 to 50000 km")
+    assert status_of["text"] == "line 7: perigee_km='abc' is not a number"
+    satellite = Satellite(2.2, 100.0, 1.0)
+    for record, (hp, ha) in zip((records[0], records[5]), ((300, 400), (350, 360)), strict=True):
+        assert record["status"] == "ok"
+        expected = lifetime(hp, ha, satellite=satellite, method="curves").days
+        assert float(record["days"]) == pytest.approx(expected, rel=1e-5)  # the CSV's 6 digits
+
+
+def test_batch_all_good_exits_0_reads_an_excel_bom_and_writes_lf(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_bytes("\ufeffperigee_km,apogee_km\r\n300,400\r\n400,400\r\n".encode())
+    out = tmp_path / "out.csv"
+    status, stdout, err = run(capsys, "lifetime", "--batch", sats, "--out", out, "--no-progress")
+    assert status == 0 and err == ""
+    assert "2 with lifetimes, 0 with a status message" in stdout
+    data = out.read_bytes()
+    assert b"\r" not in data and data.count(b"\n") == 3
+
+
+def test_batch_never_replaces_its_input_or_an_existing_file_unasked(capsys, tmp_path, monkeypatch):
+    sats = tmp_path / "sats.csv"
+    sats.write_text("perigee_km,apogee_km\n300,400\n")
+    before = sats.read_bytes()
+    status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", tmp_path / "." / "sats.csv", "--no-progress")
+    assert status == 2 and "is the input file" in err and err.count("\n") == 1
+    status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", sats, "--force", "--no-progress")
+    assert status == 2 and "is the input file" in err
+    assert sats.read_bytes() == before
+
+    out = tmp_path / "out.csv"
+    out.write_text("precious\n")
+    status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", out, "--no-progress")
+    assert (
+        status == 2
+        and err == f"orbit-env: error: --out {out} exists; give --force to replace it, or another file name\n"
+    )
+    assert out.read_text() == "precious\n"
+    status, _, _ = run(capsys, "lifetime", "--batch", sats, "--out", out, "--no-progress", "--force")
+    assert status == 0 and out.read_text().startswith("perigee_km,")
+
+    # A folder that does not exist is found before any computing.
+    def never(*args, **kwargs):
+        raise AssertionError("the batch was computed before its output was checked")
+
+    monkeypatch.setattr(catalogue, "read_batch", never)
+    monkeypatch.setattr(catalogue, "batch_lifetimes", never)
+    missing = tmp_path / "no-such-folder" / "out.csv"
+    status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", missing, "--no-progress")
+    assert status == 2 and err == (f"orbit-env: error: --out {missing}: the folder {missing.parent} does not exist\n")
+
+
+def test_batch_output_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
+    out = tmp_path / "out.csv"
+    out.write_text("earlier results\n")
+
+    def disk_full(self, rows):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(csv.DictWriter, "writerows", disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        catalogue.write_records(out, [{"perigee_km": "300", "status": "ok"}])
+    assert out.read_text() == "earlier results\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]  # no temporary file left behind
+
+
+def test_batch_refuses_a_binary_file_by_name(capsys, tmp_path):
+    sats = tmp_path / "sats.xlsx"
+    sats.write_bytes(b"PK\x03\x04\x14\x00\x06\x00\x08\x00\x00\x00!\x00\xb5U0#\xf4")
+    status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", tmp_path / "out.csv", "--no-progress")
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith(f"orbit-env: error: {sats}: not a text CSV file")
+    assert not (tmp_path / "out.csv").exists()
+
+
+# ------------------------------------------------------------------------------------------
+# fit-density: one time axis.
+
+
+def test_fit_density_reentry_on_the_observations_axis(capsys, tmp_path):
+    in_days = tmp_path / "days.csv"
+    in_days.write_text("days,perigee_km,apogee_km\n10,300,320\n")
+    dated = tmp_path / "dated.csv"
+    dated.write_text("date,perigee_km,apogee_km\n2020-09-01,300,320\n")
+    # The same decay, 31 days from the first orbit to re-entry, on either axis: the same scale.
+    status, out_days, _ = run(capsys, "fit-density", in_days, "--reentry", "41", "--json")
+    assert status == 0
+    status, out_dated, _ = run(capsys, "fit-density", dated, "--reentry", "2020-10-02", "--json")
+    assert status == 0
+    assert json.loads(out_days)["scale"] == pytest.approx(json.loads(out_dated)["scale"], rel=1e-12)
+    # Mixed axes: refused, naming both.
+    status, _, err = run(capsys, "fit-density", in_days, "--reentry", "2020-10-02")
+    assert status == 2 and err == (
+        f"orbit-env: error: --reentry 2020-10-02 is a date, but {in_days} gives its times in days "
+        "(a 'days' column); give the re-entry in days on that axis\n"
+    )
+    status, _, err = run(capsys, "fit-density", dated, "--reentry", "31")
+    assert status == 2 and "--reentry 31 is a number" in err and "'date' column" in err
+    both = tmp_path / "both.csv"
+    both.write_text("date,days,perigee_km,apogee_km\n2020-09-01,0,300,320\n")
+    status, _, err = run(capsys, "fit-density", both, "--reentry", "31")
+    assert status == 2 and "'date' and 'days'" in err and err.count("\n") == 1
+
+
+def test_fit_density_errors_name_the_file_and_line(capsys, tmp_path):
+    observations = tmp_path / "obs.csv"
+    observations.write_text("days,perigee_km,apogee_km\n0,300,320\n\n1,abc,310\n")
+    status, _, err = run(capsys, "fit-density", observations, "--reentry", "5")
+    assert status == 2 and err == f"orbit-env: error: {observations}, line 4: perigee_km='abc' is not a number\n"
+    observations.write_text("days,perigee_km,apogee_km\n0,300,320\n2,300,310\n1,299,305\n")
+    status, _, err = run(capsys, "fit-density", observations)
+    assert status == 2 and err.startswith(f"orbit-env: error: {observations}, line 4: the time is not after line 3's")
+
+
+# ------------------------------------------------------------------------------------------
+# No nonsense with exit 0.
+
+ORBIT = ["lifetime", "--perigee", "400", "--apogee", "500"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "start"),
+    [
+        (["--mass-per-area", "1e300"], "--mass-per-area 1e300 is out of range; allowed: 0.01 to 100000 kg/m^2 ("),
+        (["--density-scale", "1e300"], "--density-scale 1e300 is out of range; allowed: 0.001 to 1000 ("),
+        (["--cx", "1e6"], "--cx 1e6 is out of range; allowed: above 0 and at most 10 ("),
+        (["--mass", "1e9", "--area", "1"], "--mass 1e9 is out of range; allowed: above 0 and at most 1000000 kg ("),
+        (
+            ["--atmosphere", "exponential", "--rho0", "1.3", "--h0-km", "0", "--scale-height-km", "-8.5"],
+            "--scale-height-km -8.5 is out of range; allowed: 1 to 500 km (",
+        ),
+        (
+            ["--atmosphere", "exponential", "--scale-height-km", "8.5"],
+            "give --rho0, --h0-km and --scale-height-km together",
+        ),
+        (
+            ["--atmosphere", "msis", "--epoch", "99999-01-01"],
+            "--epoch 99999-01-01 is out of range; allowed: 1957-10-04 to 2200-12-31 (",
+        ),
+        (["--atmosphere", "msis", "--epoch", "1950-06-01"], "--epoch 1950-06-01 is out of range"),
+    ],
+)
+def test_implausible_inputs_are_refused_with_their_bounds_and_why(capsys, argv, start):
+    status, out, err = run(capsys, *ORBIT, *argv)
+    assert status == 2 and out == ""
+    assert err.startswith(f"orbit-env: error: {start}") and err.count("\n") == 1
+
+
+def test_the_exponential_law_defaults_to_orbital_heights_and_says_so(capsys):
+    status, out, _ = run(capsys, *ORBIT, "--atmosphere", "exponential", "--json")
+    assert status == 0
+    summary = json.loads(out)
+    assert "3.725e-12 kg/m^3 at 400 km, scale height 58.515 km" in summary["atmosphere"]
+    assert "default law for orbital heights" in summary["atmosphere"]
+    # Months, as for the paper's atmosphere (217 days here), not the sea-level law's millions of years.
+    assert 60 < summary["days"] < 2000
+
+
+def test_nrlmsis_says_when_the_inclination_is_not_the_users(capsys):
+    status, out, _ = run(capsys, *ORBIT, "--atmosphere", "msis")
+    assert status == 0
+    assert "inclination 0 deg" in out and "(the default: no --inclination given)" in out
+    status, out, _ = run(capsys, *ORBIT, "--atmosphere", "msis", "--inclination", "97.8")
+    assert status == 0
+    assert "inclination 97.8 deg" in out and "no --inclination given" not in out
+
+
+def test_a_solar_table_that_ends_early_is_named_with_its_dates(capsys, tmp_path):
+    table = tmp_path / "two_weeks.csv"
+    table.write_text("date,f107\n" + "".join(f"2013-10-{d:02d},120\n" for d in range(1, 15)))
+    status, out, err = run(capsys, *ORBIT, "--atmosphere", "msis", "--solar-csv", table, "--json")
+    assert status == 0
+    days = json.loads(out)["days"]
+    assert days > 60  # well past the table's 13 days
+    assert err.count("\n") == 1
+    assert err.startswith(f"orbit-env: warning: the solar table {table} ends on 2013-10-14, ")
+    reentry = np.datetime64("2013-10-01") + np.timedelta64(math.floor(days), "D")
+    assert f"before the re-entry on {reentry}" in err
+    assert "held constant" in err
+
+
+def test_no_nan_in_the_trajectory_under_changing_activity(capsys, tmp_path):
+    table = tmp_path / "table.csv"
+    table.write_text("date,f107\n2013-10-01,80\n2013-10-05,200\n2013-10-09,90\n")
+    trajectory = tmp_path / "t.csv"
+    argv = ["lifetime", "--perigee", "200", "--apogee", "230", "--atmosphere", "msis", "--solar-csv", table]
+    status, _, _ = run(capsys, *argv, "--method", "averaged", "--trajectory", trajectory)
+    assert status == 0
+    rows = list(csv.DictReader(open(trajectory)))
+    assert len(rows) > 2
+    values = np.array([[float(v) for v in row.values()] for row in rows])
+    assert np.isfinite(values).all()
+    perigee, apogee = values[:, 2], values[:, 3]
+    assert np.all(perigee <= apogee + 1e-9)
+    assert np.all(np.diff(values[:, 1]) > 0)  # days increase
+
+
+def test_check_finite_refuses_nan_and_infinity():
+    check_finite({"days": 1.0, "interval": [0.5, 2.0], "name": "x"}, "the result")
+    with pytest.raises(ValueError, match="days came out as nan"):
+        check_finite({"days": float("nan")}, "the result")
+    with pytest.raises(ValueError, match="interval came out as inf"):
+        check_finite({"interval": [1.0, float("inf")]}, "the fit")
+
+
+# ------------------------------------------------------------------------------------------
+# Files named in every file error.
+
+
+def test_a_binary_solar_file_is_named(capsys, tmp_path):
+    binary = tmp_path / "solar.bin"
+    binary.write_bytes(bytes(range(256)))
+    status, _, err = run(capsys, *ORBIT, "--atmosphere", "msis", "--solar-csv", binary)
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith(f"orbit-env: error: {binary}: not a text CSV file (byte 0x80 at offset 128 is not UTF-8")
+
+
+def test_a_solar_file_error_names_its_physical_line(capsys, tmp_path):
+    table = tmp_path / "solar.csv"
+    table.write_text("date,f107\n2013-10-01,100\n\n2013-10-02,lots\n")
+    status, _, err = run(capsys, *ORBIT, "--atmosphere", "msis", "--solar-csv", table)
+    assert status == 2 and err == f"orbit-env: error: {table}, line 4: f107='lots' is not a number\n"
