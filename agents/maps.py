@@ -76,7 +76,7 @@ def plot_burn_maps(
 
 def main(argv: list[str] | None = None) -> None:
     """Draw the DP, PPO and greedy burn maps of ``OrbitRaising-v0``."""
-    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, load_ppo, task_of
+    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, load_model, task_of
 
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", default="burn_map.png")
@@ -86,7 +86,7 @@ def main(argv: list[str] | None = None) -> None:
     apogee = np.linspace(160.0, 1600.0, 145)
     policies = {
         "dp (optimum)": dp_policy(args.env),
-        "ppo": load_ppo(args.env),
+        "ppo": load_model(args.env)[1],
         "greedy": hand_coded_policies(args.env)["greedy"],
     }
     maps = burn_map(args.env, policies, perigee, apogee)

@@ -10,6 +10,7 @@ output with the default file::
 
 from __future__ import annotations
 
+import json
 import time
 import tomllib
 from collections.abc import Callable
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 try:
+    from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import VecEnvWrapper
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
@@ -36,7 +38,9 @@ class TrainResult:
     model_path: Path
     log_dir: Path
     seconds: float
-    timesteps: int
+    timesteps: int  #: the model's timesteps in all (with a resumed checkpoint's)
+    trained: int = 0  #: timesteps trained by this run
+    best_model_path: Path | None = None  #: the evaluation callback's best model, if it ran
 
 
 class MissionEndIsTerminal(VecEnvWrapper):
@@ -59,33 +63,187 @@ class MissionEndIsTerminal(VecEnvWrapper):
         return obs, rewards, dones, infos
 
 
+#: Top-level keys of a training config: (type, default; None: required). Every key is checked.
+TOP_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {
+    "env_id": (str, None),
+    "seed": (int, None),
+    "num_envs": (int, None),
+    "total_timesteps": (int, None),
+    "checkpoint_every": (int, 0),
+    "eval_every": (int, 0),
+    "eval_episodes": (int, 200),
+    "bootstrap_at_horizon": (bool, True),
+    "shaping": (str, "none"),
+    "end_decided": ((int, float), 0.0),
+    "learning_rate_schedule": (str, "constant"),
+    "learning_rate_decay_start": ((int, float), 0.0),
+}
+#: Tables of a training config and the keys each takes (``env``: the environment's keywords).
+POLICY_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {
+    "net_arch": (list, [64, 64]),
+    "activation": (str, "tanh"),
+    "initial_coast_logit": ((int, float), 0.0),
+    "initial_action_mean": ((int, float), 0.0),
+    "log_std_init": ((int, float), 0.0),
+    "log_features": (bool, False),
+}
+NORMALIZE_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {"reward": (bool, False)}
+#: The policy network's activations by name.
+ACTIVATIONS = ("tanh", "relu", "elu", "gelu", "leaky_relu")
+#: Seed of the evaluation callback's episodes (training uses the config's seed, ``orbit-env evaluate`` 12345).
+VALIDATION_SEED = 777
+#: PPO's constructor arguments a config may not set: the command sets them.
+_PPO_RESERVED = ("self", "policy", "env", "tensorboard_log", "policy_kwargs", "verbose", "seed", "device")
+
+
+def _type_name(kind: type | tuple[type, ...]) -> str:
+    names = {int: "an integer", float: "a number", bool: "true or false", str: "a string", list: "a list"}
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    return "a number" if float in kinds else names.get(kinds[0], kinds[0].__name__)
+
+
+def _check_table(
+    table: Any, schema: dict[str, tuple[type | tuple[type, ...], Any]], where: str, source: str
+) -> dict[str, Any]:
+    """The table with its defaults, after checking every key and type (ValueError on one line)."""
+    if not isinstance(table, dict):
+        raise ValueError(f"{source}: {where} must be a table")
+    for key, value in table.items():
+        if key not in schema:
+            raise ValueError(f"{source}: unknown key {where}{key!r}; valid keys: {', '.join(schema)}")
+        kind = schema[key][0]
+        kinds = kind if isinstance(kind, tuple) else (kind,)
+        if not isinstance(value, kinds) or (isinstance(value, bool) and bool not in kinds):
+            raise ValueError(f"{source}: {where}{key} = {value!r} is invalid; allowed: {_type_name(kind)}")
+    missing = [key for key, (_, default) in schema.items() if default is None and key not in table]
+    if missing:
+        raise ValueError(f"{source}: the key {where}{missing[0]!r} is missing")
+    return {key: table.get(key, default) for key, (_, default) in schema.items()}
+
+
+def _ppo_schema() -> dict[str, tuple[type | tuple[type, ...], Any]]:
+    """The ``[ppo]`` keys: PPO's constructor arguments, typed by their defaults."""
+    import inspect
+
+    from stable_baselines3 import PPO
+
+    schema: dict[str, tuple[type | tuple[type, ...], Any]] = {}
+    for name, parameter in inspect.signature(PPO.__init__).parameters.items():
+        if name in _PPO_RESERVED or name.startswith("_"):
+            continue
+        default = parameter.default
+        if isinstance(default, bool):
+            kind: type | tuple[type, ...] = bool
+        elif isinstance(default, (int, float)):
+            kind = (int, float) if isinstance(default, float) or name in ("learning_rate", "clip_range") else int
+        else:  # None: a number or a table (clip_range_vf, target_kl, rollout_buffer_kwargs)
+            kind = (int, float, dict, str)
+        schema[name] = (kind, "absent")
+    return schema
+
+
 def load_config(path: str | Path | None = None) -> dict[str, Any]:
-    """Read a training config (default: the shipped ``agents/ppo.toml``)."""
-    if path is None:
-        text = resources.files("orbit_env.agents").joinpath(DEFAULT_CONFIG).read_text()
-    else:
-        text = Path(path).read_text()
-    config = tomllib.loads(text)
-    for key in ("env_id", "seed", "num_envs", "total_timesteps", "ppo", "policy"):
-        if key not in config:
-            raise ValueError(f"training config {path or DEFAULT_CONFIG} lacks the key {key!r}")
-    schedule = config.get("learning_rate_schedule", "constant")
-    if schedule not in ("constant", "linear"):
-        raise ValueError(f"learning_rate_schedule={schedule!r} is invalid; allowed: constant, linear")
-    decay_start = config.get("learning_rate_decay_start", 0.0)
-    if not (isinstance(decay_start, (int, float)) and 0.0 <= decay_start < 1.0):
-        raise ValueError(f"learning_rate_decay_start={decay_start!r} is invalid; allowed: a fraction in [0, 1)")
-    shaping = config.get("shaping", "none")
-    if shaping not in SHAPINGS:
-        raise ValueError(f"shaping={shaping!r} is invalid; allowed: {', '.join(SHAPINGS)}")
-    end_decided = config.get("end_decided", 0.0)
-    if not (isinstance(end_decided, (int, float)) and 0.0 <= end_decided <= 1.0):
-        raise ValueError(f"end_decided={end_decided!r} is invalid; allowed: a probability in [0, 1]")
-    if end_decided > 0.0 and shaping != "never_burn_value":
-        raise ValueError('end_decided > 0 needs shaping = "never_burn_value" (it ends episodes on its potential)')
-    if int(config["total_timesteps"]) <= 0 or int(config["num_envs"]) <= 0:
-        raise ValueError("total_timesteps and num_envs must be positive integers")
+    """Read and check a training config (default: the shipped ``agents/ppo.toml``).
+
+    Every key is checked: an unknown key, a wrong type or value, a TOML syntax error
+    or an env id that is not this package's is one ``ValueError`` line naming the
+    file (and the line, for syntax), the key and what is allowed.
+    """
+    source = DEFAULT_CONFIG if path is None else str(path)
+    try:
+        if path is None:
+            text = resources.files("orbit_env.agents").joinpath(DEFAULT_CONFIG).read_text()
+        else:
+            text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise ValueError(f"cannot read the training config {source}: {error}") from None
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ValueError(f"{source}: not valid TOML: {error}") from None
+    tables = {"ppo": _ppo_schema(), "policy": POLICY_KEYS, "normalize": NORMALIZE_KEYS, "env": None}
+    top = {key: value for key, value in raw.items() if key not in tables}
+    for key in top:
+        if key not in TOP_KEYS:
+            valid = ", ".join([*TOP_KEYS, *(f"[{t}]" for t in tables)])
+            raise ValueError(f"{source}: unknown key {key!r}; valid keys: {valid}")
+    config = _check_table(top, TOP_KEYS, "", source)
+    ppo = _check_table(raw.get("ppo", {}), tables["ppo"], "ppo.", source)
+    config["ppo"] = {key: value for key, value in ppo.items() if value != "absent"}
+    config["policy"] = _check_table(raw.get("policy", {}), POLICY_KEYS, "policy.", source)
+    config["normalize"] = _check_table(raw.get("normalize", {}), NORMALIZE_KEYS, "normalize.", source)
+    env_keywords = raw.get("env", {})
+    if not isinstance(env_keywords, dict):
+        raise ValueError(f"{source}: env must be a table of the environment's keywords")
+    config["env"] = dict(env_keywords)
+    _check_values(config, source)
     return config
+
+
+def _check_values(config: dict[str, Any], source: str) -> None:
+    """The values' ranges and the combinations that cannot work (ValueError naming the key)."""
+    from orbit_env.envs import ENV_IDS
+
+    if config["env_id"] not in ENV_IDS:
+        raise ValueError(
+            f"{source}: env_id = {config['env_id']!r} is not an orbit_env environment; allowed: {', '.join(ENV_IDS)}"
+        )
+    for key in ("seed", "checkpoint_every", "eval_every"):
+        if config[key] < 0:
+            raise ValueError(f"{source}: {key} = {config[key]} is invalid; allowed: an integer >= 0")
+    for key in ("num_envs", "total_timesteps", "eval_episodes"):
+        if config[key] <= 0:
+            raise ValueError(f"{source}: {key} = {config[key]} is invalid; allowed: an integer >= 1")
+    if config["learning_rate_schedule"] not in ("constant", "linear"):
+        raise ValueError(
+            f"{source}: learning_rate_schedule = {config['learning_rate_schedule']!r} is invalid; "
+            "allowed: constant, linear"
+        )
+    if not 0.0 <= config["learning_rate_decay_start"] < 1.0:
+        raise ValueError(
+            f"{source}: learning_rate_decay_start={config['learning_rate_decay_start']!r} is invalid; "
+            "allowed: a fraction in [0, 1)"
+        )
+    if config["shaping"] not in SHAPINGS:
+        raise ValueError(f"{source}: shaping={config['shaping']!r} is invalid; allowed: {', '.join(SHAPINGS)}")
+    if not 0.0 <= config["end_decided"] <= 1.0:
+        raise ValueError(
+            f"{source}: end_decided={config['end_decided']!r} is invalid; allowed: a probability in [0, 1]"
+        )
+    if config["end_decided"] > 0.0 and config["shaping"] != "never_burn_value":
+        raise ValueError(
+            f'{source}: end_decided > 0 needs shaping = "never_burn_value" (it ends episodes on its potential)'
+        )
+    policy = config["policy"]
+    if policy["activation"] not in ACTIVATIONS:
+        raise ValueError(
+            f"{source}: policy.activation = {policy['activation']!r} is invalid; allowed: {', '.join(ACTIVATIONS)}"
+        )
+    arch = policy["net_arch"]
+    if not arch or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in arch):
+        raise ValueError(f"{source}: policy.net_arch = {arch!r} is invalid; allowed: a list of layer widths >= 1")
+    ppo = config["ppo"]
+    for key in ("n_steps", "batch_size", "n_epochs"):
+        if key in ppo and ppo[key] < 1:
+            raise ValueError(f"{source}: ppo.{key} = {ppo[key]} is invalid; allowed: an integer >= 1")
+    for key in ("gamma", "gae_lambda"):
+        if key in ppo and not 0.0 <= ppo[key] <= 1.0:
+            raise ValueError(f"{source}: ppo.{key} = {ppo[key]} is invalid; allowed: a number in [0, 1]")
+    if "learning_rate" in ppo and not ppo["learning_rate"] > 0.0:
+        raise ValueError(f"{source}: ppo.learning_rate = {ppo['learning_rate']} is invalid; allowed: a number > 0")
+    _check_env_keywords(config["env_id"], config["env"], source)
+
+
+def _check_env_keywords(env_id: str, keywords: dict[str, Any], source: str) -> None:
+    """The ``[env]`` table makes the environment (ValueError naming the bad keyword)."""
+    import gymnasium
+
+    import orbit_env  # noqa: F401  (registers the environments)
+
+    try:
+        gymnasium.make(env_id, **keywords).close()
+    except ValueError as error:
+        raise ValueError(f"{source}: [env] {error}") from None
 
 
 def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
@@ -97,26 +255,135 @@ def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
     return lambda progress_left: rate * min(1.0, progress_left / left_at_start)
 
 
+def rollout_size(config: dict[str, Any]) -> int:
+    """Transitions per PPO update: ``n_steps`` (SB3's default 2048) times ``num_envs``."""
+    return int(config["ppo"].get("n_steps", 2048)) * int(config["num_envs"])
+
+
+def timesteps_to_train(requested: int, config: dict[str, Any]) -> int:
+    """``requested`` rounded up to whole rollouts: what SB3 trains (and the progress bar counts)."""
+    size = rollout_size(config)
+    return -(-int(requested) // size) * size
+
+
+class BestModelCallback(BaseCallback):
+    """Score the policy on the same seeded episodes of the plain environment; keep the best model.
+
+    Every ``every_calls`` steps of the vector env it plays one episode per
+    sub-environment of ``gymnasium.make_vec(env_id, num_envs=episodes, **env_kwargs)``
+    seeded with ``seed`` (:func:`orbit_env.agents.evaluate.run_episodes`: the
+    unshaped reward, deterministic actions), logs ``eval/mean_reward`` to
+    tensorboard, saves the best so far to ``save_dir/best_model.zip`` and every
+    score to ``save_dir/evaluations.json``. SB3's ``EvalCallback`` draws new
+    episodes each time and would compare the policies on different starts.
+
+    Args:
+        env_id: The environment trained on.
+        env_kwargs: Its keywords (the config's ``[env]`` table).
+        every_calls: Steps of the vector env between evaluations (>= 1).
+        episodes: Episodes per evaluation.
+        seed: Seed of the episodes.
+        save_dir: Folder of ``best_model.zip`` and ``evaluations.json``.
+        resume: Continue the scores of ``save_dir/evaluations.json``: a new model is
+            saved only if it beats them.
+    """
+
+    def __init__(
+        self,
+        env_id: str,
+        env_kwargs: dict[str, Any],
+        every_calls: int,
+        episodes: int,
+        seed: int,
+        save_dir: str | Path,
+        resume: bool = False,
+    ) -> None:
+        super().__init__(verbose=0)
+        self.env_id = env_id
+        self.env_kwargs = dict(env_kwargs)
+        self.every_calls = max(int(every_calls), 1)
+        self.episodes = int(episodes)
+        self.seed = int(seed)
+        self.save_dir = Path(save_dir)
+        self.best_mean = -float("inf")
+        self.evaluations: list[dict[str, float]] = []
+        if resume and (self.save_dir / "evaluations.json").is_file():
+            # A resumed run's best model stays the best unless beaten.
+            self.evaluations = json.loads((self.save_dir / "evaluations.json").read_text())
+            self.best_mean = max((e["mean_return"] for e in self.evaluations), default=-float("inf"))
+
+    @property
+    def best_model_path(self) -> Path:
+        """Where the best model goes."""
+        return self.save_dir / "best_model.zip"
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.every_calls == 0:
+            self.evaluate()
+        return True
+
+    def evaluate(self) -> float:
+        """Score the current policy now; save it if it is the best so far; return its mean return."""
+        from orbit_env.agents.evaluate import run_episodes
+
+        result = run_episodes(self.env_id, self.model, self.episodes, self.seed, env_kwargs=self.env_kwargs)
+        mean = float(result.returns.mean())
+        self.logger.record("eval/mean_reward", mean)
+        self.save_dir.mkdir(parents=True, exist_ok=True)
+        if mean > self.best_mean:
+            self.best_mean = mean
+            self.model.save(self.best_model_path, exclude=["env", "tensorboard_log"])
+        self.logger.record("eval/best_mean_reward", self.best_mean)
+        self.evaluations.append({"timesteps": int(self.model.num_timesteps), "mean_return": mean})
+        (self.save_dir / "evaluations.json").write_text(json.dumps(self.evaluations, indent=1) + "\n")
+        return mean
+
+
+def _vecnormalize_path(checkpoint: Path) -> Path:
+    """The reward statistics CheckpointCallback saves beside ``rl_model_N_steps.zip``."""
+    return checkpoint.with_name(checkpoint.name.replace("rl_model_", "rl_model_vecnormalize_")).with_suffix(".pkl")
+
+
 def train(
     config_path: str | Path | None = None,
     out_dir: str | Path = "runs/ppo",
     *,
     total_timesteps: int | None = None,
+    seed: int | None = None,
+    num_envs: int | None = None,
+    env_id: str | None = None,
+    resume: str | Path | None = None,
+    force: bool = False,
     progress: bool = True,
 ) -> TrainResult:
     """Train PPO as the config says; return where the model went.
 
+    The arguments other than ``config_path`` override the config. Episode returns go
+    to tensorboard (``rollout/ep_rew_mean``, by SB3's ``VecMonitor``: with shaping,
+    the shaped return PPO maximizes) and, with ``eval_every``, the plain env's mean
+    return on fixed validation episodes (``eval/mean_reward``, :class:`BestModelCallback`).
+
     Args:
         config_path: TOML file of hyperparameters (default: the shipped one).
-        out_dir: Folder for ``model.zip``, ``checkpoints/`` and ``tensorboard/``.
-        total_timesteps: Override the config's budget (smoke tests use a tiny one).
-        progress: Show SB3's progress bar.
+        out_dir: Folder for ``model.zip``, ``best_model.zip``, ``checkpoints/`` and ``tensorboard/``.
+        total_timesteps: The run's budget, rounded up to whole rollouts (default: the config's).
+        seed: Seed of the run (default: the config's).
+        num_envs: Satellites stepped together (default: the config's).
+        env_id: Environment (default: the config's ``env_id``); the ``[env]`` keywords still apply.
+        resume: A checkpoint (``checkpoints/rl_model_N_steps.zip``) to continue from,
+            up to the same total budget.
+        force: Overwrite a finished run in ``out_dir`` (otherwise it is kept: ValueError).
+        progress: Show a progress bar.
+
+    Raises:
+        ValueError: a bad config or argument, a finished run in ``out_dir`` without
+            ``force``, a missing checkpoint.
     """
     try:
         import torch
         from stable_baselines3 import PPO
         from stable_baselines3.common.callbacks import CheckpointCallback
-        from stable_baselines3.common.vec_env import VecNormalize
+        from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
 
@@ -124,59 +391,123 @@ def train(
     from orbit_env.envs.sb3 import make_sb3_vec_env
 
     config = load_config(config_path)
-    timesteps = int(total_timesteps if total_timesteps is not None else config["total_timesteps"])
-    if timesteps <= 0:
-        raise ValueError(f"total_timesteps must be positive, got {timesteps}")
+    source = DEFAULT_CONFIG if config_path is None else str(config_path)
+    overrides = {"total_timesteps": total_timesteps, "seed": seed, "num_envs": num_envs, "env_id": env_id}
+    for key, value in overrides.items():
+        if value is not None:
+            config[key] = value
+    _check_values(config, source)
+    timesteps = timesteps_to_train(config["total_timesteps"], config)
     out = Path(out_dir)
+    model_path = out / "model.zip"
+    if model_path.exists() and not force and resume is None:
+        raise ValueError(f"{model_path} exists: a finished run is kept; pass --force to overwrite it")
+    checkpoint = None if resume is None else Path(resume)
+    if checkpoint is not None and not checkpoint.is_file():
+        raise ValueError(f"no checkpoint at {checkpoint}")
     out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
     seed = int(config["seed"])
-    venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed)
-    if not config.get("bootstrap_at_horizon", True):
+    venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed, **config["env"])
+    if not config["bootstrap_at_horizon"]:
         venv = MissionEndIsTerminal(venv)
-    if config.get("shaping", "none") == "never_burn_value":
+    if config["shaping"] == "never_burn_value":
         from orbit_env.agents.shaping import never_burn_value_shaping
 
         # Before VecNormalize: it scales the shaped reward.
-        venv = never_burn_value_shaping(venv, end_decided=float(config.get("end_decided", 0.0)), seed=seed)
-    if config.get("normalize", {}).get("reward", False):
-        venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=float(config["ppo"]["gamma"]))
-    activation = {"tanh": torch.nn.Tanh, "relu": torch.nn.ReLU}[config["policy"].get("activation", "tanh")]
-    policy_kwargs: dict[str, Any] = {"net_arch": list(config["policy"]["net_arch"]), "activation_fn": activation}
-    if config["policy"].get("log_features", False):
+        venv = never_burn_value_shaping(venv, end_decided=float(config["end_decided"]), seed=seed)
+    venv = VecMonitor(venv)  # episode returns and lengths for tensorboard
+    gamma = float(config["ppo"].get("gamma", 0.99))
+    if config["normalize"]["reward"]:
+        stats = None if checkpoint is None else _vecnormalize_path(checkpoint)
+        if stats is not None and stats.is_file():
+            venv = VecNormalize.load(str(stats), venv)
+        else:
+            venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
+    if checkpoint is not None:
+        model = PPO.load(checkpoint, env=venv, device="cpu", tensorboard_log=str(out / "tensorboard"))
+        model.set_random_seed(seed + int(model.num_timesteps))
+    else:
+        model = _new_model(PPO, torch, config, venv, out)
+    model.orbit_env = {"env_id": config["env_id"], "env": dict(config["env"])}  # saved with the model
+    callbacks: list[Any] = []
+    every = int(config["checkpoint_every"])
+    calls = lambda steps: max(steps // int(config["num_envs"]), 1)  # noqa: E731  (timesteps -> env steps)
+    if every > 0:
+        callbacks.append(
+            CheckpointCallback(save_freq=calls(every), save_path=str(out / "checkpoints"), save_vecnormalize=True)
+        )
+    best = None
+    if config["eval_every"] > 0:
+        best = BestModelCallback(
+            config["env_id"],
+            config["env"],
+            calls(config["eval_every"]),
+            config["eval_episodes"],
+            VALIDATION_SEED,
+            out,
+            resume=checkpoint is not None,
+        )
+        callbacks.append(best)
+    remaining = max(timesteps - int(model.num_timesteps), 0)
+    start = time.perf_counter()
+    if remaining > 0:
+        model.learn(
+            total_timesteps=remaining,
+            callback=callbacks,
+            progress_bar=progress,
+            tb_log_name="ppo",
+            reset_num_timesteps=checkpoint is None,
+        )
+    if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):
+        best.evaluate()  # the final policy competes too
+    seconds = time.perf_counter() - start
+    model.save(model_path, exclude=["env", "tensorboard_log"])
+    return TrainResult(
+        model_path=model_path,
+        log_dir=out / "tensorboard",
+        seconds=seconds,
+        timesteps=int(model.num_timesteps),
+        trained=remaining,
+        best_model_path=None if best is None else best.best_model_path,
+    )
+
+
+def _new_model(ppo_class: Any, torch: Any, config: dict[str, Any], venv: Any, out: Path) -> Any:
+    """A fresh PPO as the config's ``[ppo]`` and ``[policy]`` say."""
+    policy = config["policy"]
+    activation = {
+        "tanh": torch.nn.Tanh,
+        "relu": torch.nn.ReLU,
+        "elu": torch.nn.ELU,
+        "gelu": torch.nn.GELU,
+        "leaky_relu": torch.nn.LeakyReLU,
+    }[policy["activation"]]
+    policy_kwargs: dict[str, Any] = {"net_arch": list(policy["net_arch"]), "activation_fn": activation}
+    if policy["log_features"]:
         from orbit_env.agents.features import LogFeatures
 
         policy_kwargs["features_extractor_class"] = LogFeatures
+    if policy["log_std_init"]:
+        policy_kwargs["log_std_init"] = float(policy["log_std_init"])
     ppo_kwargs = dict(config["ppo"])
-    if config.get("learning_rate_schedule", "constant") == "linear":
+    if config["learning_rate_schedule"] == "linear":
         ppo_kwargs["learning_rate"] = linear_decay(
-            float(ppo_kwargs["learning_rate"]), float(config.get("learning_rate_decay_start", 0.0))
+            float(ppo_kwargs.get("learning_rate", 3e-4)), float(config["learning_rate_decay_start"])
         )
-    model = PPO(
+    model = ppo_class(
         "MlpPolicy",
         venv,
-        seed=seed,
+        seed=int(config["seed"]),
         verbose=0,
         device="cpu",
         tensorboard_log=str(out / "tensorboard"),
         policy_kwargs=policy_kwargs,
         **ppo_kwargs,
     )
-    coast_logit = float(config["policy"].get("initial_coast_logit", 0.0))
-    if coast_logit:
+    with torch.no_grad():
         # Burns are rare decisions: a uniform initial policy burns a third of the time and
         # empties the tank in days, so it never learns what keeping propellant is worth.
-        with torch.no_grad():
-            model.policy.action_net.bias[0] += coast_logit
-    callbacks = []
-    every = int(config.get("checkpoint_every", 0))
-    if every > 0:
-        callbacks.append(
-            CheckpointCallback(save_freq=max(every // int(config["num_envs"]), 1), save_path=str(out / "checkpoints"))
-        )
-    start = time.perf_counter()
-    model.learn(total_timesteps=timesteps, callback=callbacks, progress_bar=progress, tb_log_name="ppo")
-    seconds = time.perf_counter() - start
-    model_path = out / "model.zip"
-    model.save(model_path, exclude=["env", "tensorboard_log"])
-    return TrainResult(model_path=model_path, log_dir=out / "tensorboard", seconds=seconds, timesteps=timesteps)
+        # Discrete: the coast's logit; continuous: the Gaussian's mean (a < 0 coasts).
+        model.policy.action_net.bias[0] += float(policy["initial_coast_logit"]) + float(policy["initial_action_mean"])
+    return model

@@ -1,5 +1,6 @@
 """Training options of ``orbit-env train``: the log features, the learning-rate schedule, config checks."""
 
+import json
 import math
 
 import numpy as np
@@ -59,3 +60,170 @@ def test_training_config_checks_name_the_bad_value(tmp_path, extra, message):
 def test_shipped_config_is_accepted():
     config = load_config()
     assert config["env_id"] == "OrbitRaising-v0" and config["total_timesteps"] > 0
+
+
+# --------------------------------------------------------------------------------------
+# Strict configs: every key checked, one line naming the file, the key and what is allowed
+# --------------------------------------------------------------------------------------
+
+TINY = """\
+env_id = "OrbitRaising-v0"
+seed = 0
+num_envs = 8
+total_timesteps = 100
+checkpoint_every = 128
+eval_every = 128
+eval_episodes = 8
+shaping = "never_burn_value"
+end_decided = 1.0
+bootstrap_at_horizon = false
+[env]
+horizon_steps = 30
+[ppo]
+n_steps = 16
+batch_size = 64
+n_epochs = 1
+gamma = 1.0
+[policy]
+net_arch = [16]
+initial_coast_logit = 2.0
+[normalize]
+reward = true
+"""
+
+
+def write(tmp_path, text, name="config.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            "n_epochs = 1",
+            "n_epochs = 1\nlearning_rat = 1e-3",
+            r"unknown key ppo\.'learning_rat'; valid.*learning_rate",
+        ),
+        ("num_envs = 8", "num_env = 8", r"unknown key 'num_env'; valid keys: env_id, seed, num_envs"),
+        ('shaping = "never_burn_value"', 'shapng = "never_burn_value"', r"unknown key 'shapng'"),
+        (
+            "net_arch = [16]",
+            'net_arch = [16]\nactivation = "swish"',
+            r"activation = 'swish' is invalid; allowed: tanh",
+        ),
+        ("num_envs = 8", 'num_envs = "8"', r"num_envs = '8' is invalid; allowed: an integer"),
+        ("n_epochs = 1", "n_epochs = 1.5", r"ppo\.n_epochs = 1\.5 is invalid; allowed: an integer"),
+        ("gamma = 1.0", "gamma = 1.5", r"ppo\.gamma = 1\.5 is invalid; allowed: a number in \[0, 1\]"),
+        ("net_arch = [16]", "net_arch = [16, 0]", r"policy\.net_arch = \[16, 0\] is invalid"),
+        ("seed = 0\n", "", r"the key 'seed' is missing"),
+        (
+            'env_id = "OrbitRaising-v0"',
+            'env_id = "CartPole-v1"',
+            r"'CartPole-v1' is not an orbit_env environment",
+        ),
+        (
+            "horizon_steps = 30",
+            "horizn_steps = 30",
+            r"\[env\] unknown keyword 'horizn_steps'; valid.*horizon_steps",
+        ),
+        ("horizon_steps = 30", "horizon_steps = 0", r"\[env\] horizon_steps=0 is out of range"),
+        ("reward = true", "reward = 1", r"normalize\.reward = 1 is invalid; allowed: true or false"),
+    ],
+)
+def test_bad_training_configs_are_one_line_errors_naming_the_file_and_key(tmp_path, old, new, message):
+    assert old in TINY
+    path = write(tmp_path, TINY.replace(old, new))
+    with pytest.raises(ValueError, match=message) as raised:
+        load_config(path)
+    assert str(raised.value).startswith(str(path)) and "\n" not in str(raised.value)
+
+
+def test_toml_syntax_errors_name_the_file_and_line(tmp_path):
+    path = write(tmp_path, TINY.replace("seed = 0", "seed = = 0"))
+    with pytest.raises(ValueError, match=rf"^{path}: not valid TOML: .*line 2"):
+        load_config(path)
+    with pytest.raises(ValueError, match=r"cannot read the training config .*nowhere\.toml"):
+        load_config(tmp_path / "nowhere.toml")
+
+
+def test_the_cli_says_a_bad_config_in_one_line(tmp_path, capsys):
+    from orbit_env.cli import main
+
+    path = write(tmp_path, TINY.replace("num_envs = 8", "num_env = 8"))
+    assert main(["train", "--config", str(path), "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown key 'num_env'" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("name", ["ppo.toml", "ppo_uncertain.toml", "ppo_continuous.toml"])
+def test_shipped_configs_pass_the_strict_check(name):
+    from importlib import resources
+
+    config = load_config(resources.files("orbit_env.agents").joinpath(name))
+    assert config["total_timesteps"] > 0
+
+
+def test_budgets_round_up_to_whole_rollouts():
+    from orbit_env.agents.train import timesteps_to_train
+
+    config = {"ppo": {"n_steps": 512}, "num_envs": 64}  # 32768 transitions per update
+    assert timesteps_to_train(40_000, config) == 65_536
+    assert timesteps_to_train(32_768, config) == 32_768
+    assert timesteps_to_train(1, {"ppo": {}, "num_envs": 2}) == 4096  # SB3's default n_steps 2048
+
+
+# --------------------------------------------------------------------------------------
+# orbit-env train: monitor, evaluation callback, --out kept, --resume, overrides
+# --------------------------------------------------------------------------------------
+
+
+def scalars(log_dir):
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    tags = set()
+    for run in log_dir.iterdir():
+        accumulator = EventAccumulator(str(run))
+        accumulator.Reload()
+        tags |= set(accumulator.Tags()["scalars"])
+    return tags
+
+
+def test_train_logs_episodes_keeps_the_best_resumes_and_keeps_a_finished_run(tmp_path, capsys):
+    from stable_baselines3 import PPO
+
+    from orbit_env.agents.train import train
+    from orbit_env.cli import main
+
+    path = write(tmp_path, TINY)
+    out = tmp_path / "run"
+    result = train(path, out, progress=False)
+    assert result.trained == result.timesteps == 128  # 100 rounded up to one rollout of 16 x 8
+    assert {"rollout/ep_rew_mean", "eval/mean_reward"} <= scalars(result.log_dir)
+    assert result.best_model_path == out / "best_model.zip" and result.best_model_path.is_file()
+    evaluations = json.loads((out / "evaluations.json").read_text())
+    assert [e["timesteps"] for e in evaluations] == [128]
+    model = PPO.load(result.model_path, device="cpu")
+    assert model.orbit_env == {"env_id": "OrbitRaising-v0", "env": {"horizon_steps": 30}}
+    checkpoint = out / "checkpoints" / "rl_model_128_steps.zip"
+    assert checkpoint.is_file() and (out / "checkpoints" / "rl_model_vecnormalize_128_steps.pkl").is_file()
+    # A finished run is kept: one line, exit 2, and the model untouched.
+    stamp = result.model_path.stat().st_mtime_ns
+    assert main(["train", "--config", str(path), "--out", str(out), "--no-progress"]) == 2
+    assert "exists: a finished run is kept; pass --force" in capsys.readouterr().err
+    assert result.model_path.stat().st_mtime_ns == stamp
+    # Resume from the checkpoint up to a larger budget: the timesteps continue.
+    resumed = train(path, out, total_timesteps=384, resume=checkpoint, progress=False)
+    assert resumed.trained == 256 and resumed.timesteps == 384
+    assert PPO.load(resumed.model_path, device="cpu").num_timesteps == 384
+    assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128, 256, 384]
+    with pytest.raises(ValueError, match="no checkpoint at"):
+        train(path, out, resume=out / "missing.zip", progress=False)
+    # --force overwrites, and the overrides reach the run.
+    overrides = ["--seed", "3", "--n-envs", "4", "--env", "OrbitRaisingContinuous-v0", "--timesteps", "64"]
+    status = main(["train", "--config", str(path), "--out", str(out), "--force", "--no-progress", *overrides])
+    assert status == 0
+    assert "trained 64 timesteps" in capsys.readouterr().out
+    model = PPO.load(out / "model.zip", device="cpu")
+    assert model.orbit_env["env_id"] == "OrbitRaisingContinuous-v0" and model.n_envs == 4 and model.seed == 3

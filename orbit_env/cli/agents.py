@@ -7,33 +7,58 @@ import json
 import sys
 from typing import Any
 
-from orbit_env.cli.common import positive_int
+from orbit_env.cli.common import PROG, positive_int
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
     from orbit_env.agents.train import train
 
-    result = train(args.config, args.out, total_timesteps=args.timesteps, progress=not args.no_progress)
-    print(f"trained {result.timesteps} timesteps in {result.seconds:.0f} s")
+    result = train(
+        args.config,
+        args.out,
+        total_timesteps=args.timesteps,
+        seed=args.seed,
+        num_envs=args.n_envs,
+        env_id=args.env,
+        resume=args.resume,
+        force=args.force,
+        progress=not args.no_progress,
+    )
+    print(f"trained {result.trained} timesteps in {result.seconds:.0f} s ({result.timesteps} in all)")
     print(f"model: {result.model_path}  (tensorboard --logdir {result.log_dir})")
+    if result.best_model_path is not None:
+        print(f"best on the validation episodes: {result.best_model_path}")
     return 0
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from orbit_env.agents.evaluate import all_policies, evaluate, format_table, paired_difference, plot_returns
+    from orbit_env.agents.evaluate import (
+        ALGORITHMS,
+        all_policies,
+        check_env_id,
+        evaluate,
+        format_table,
+        paired_difference,
+        plot_returns,
+    )
 
     def say(name: str) -> None:
         if not args.json:
             print(f"  running {name} ...", file=sys.stderr)
 
-    policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say)
+    def warn(message: str) -> None:
+        print(f"{PROG}: warning: {message}", file=sys.stderr)
+
+    check_env_id(args.env)
+    policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say, warn=warn)
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
         plot_returns(results, args.env, args.plot)
-    # PPO against the best hand-coded policy, then against the optimum.
+    # The learned agent against the best hand-coded policy, then against the optimum.
+    learned = next((name for name in results if name in ALGORITHMS), "ppo")
     paired = {
-        "paired_difference": paired_difference(results),
-        "paired_to_dp": paired_difference(results, baseline="dp"),
+        "paired_difference": paired_difference(results, name=learned),
+        "paired_to_dp": paired_difference(results, name=learned, baseline="dp"),
     }
     if args.json:
         out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}
@@ -50,7 +75,16 @@ def add_parsers(sub: Any) -> None:
     tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
     tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
     tr.add_argument("--out", default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)")
-    tr.add_argument("--timesteps", type=positive_int, metavar="N", help="override the config's total_timesteps")
+    tr.add_argument(
+        "--timesteps", type=positive_int, metavar="N", help="override total_timesteps (rounded up to whole rollouts)"
+    )
+    tr.add_argument("--seed", type=int, metavar="S", help="override the config's seed")
+    tr.add_argument(
+        "--n-envs", type=positive_int, metavar="N", help="override num_envs, the satellites stepped together"
+    )
+    tr.add_argument("--env", metavar="ID", help="override env_id (the config's [env] keywords still apply)")
+    tr.add_argument("--resume", metavar="ZIP", help="continue from a checkpoint (DIR/checkpoints/rl_model_N_steps.zip)")
+    tr.add_argument("--force", action="store_true", help="overwrite a finished run in --out (otherwise it is kept)")
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     tr.set_defaults(func=_cmd_train)
 
@@ -64,7 +98,11 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--seed", type=int, default=EVAL_SEED, metavar="S", help=f"seed of the episodes (default {EVAL_SEED})"
     )
-    ev.add_argument("--model", metavar="ZIP", help="PPO model (default: the shipped one for the environment)")
+    ev.add_argument(
+        "--model",
+        metavar="ZIP",
+        help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment)",
+    )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
