@@ -246,6 +246,13 @@ class CurvePoint:
         self.__dict__["nu"] = nu  # the cached property's slot (a frozen dataclass: no setattr)
         return self
 
+    @classmethod
+    def _with_nu(cls, label: FloatArray, tau: FloatArray, mean_period_s: FloatArray, nu: FloatArray) -> CurvePoint:
+        """A point with its nu known, made without the frozen dataclass's checked __init__ (the envs' hot path)."""
+        point = object.__new__(cls)
+        point.__dict__.update(label=label, tau=tau, mean_period_s=mean_period_s, nu=nu)
+        return point
+
 
 def _check_curve_limits(hp: FloatArray, ha: FloatArray, names: tuple[str, str], unit: str, unit_m: float) -> None:
     for name, values, limit in ((names[0], hp, CURVES_MAX_PERIGEE_M), (names[1], ha, CURVES_MAX_APOGEE_M)):
@@ -505,7 +512,7 @@ class UniversalCurves:
             perigee_m, apogee_m, q = self.at(label, tau)
         else:
             perigee_m, apogee_m, q = _heights(label, *self._table_b.on_segments(segments, label, tau))
-        return CurvePoint(label=label, tau=tau, mean_period_s=q)._known_nu(nu), perigee_m, apogee_m
+        return CurvePoint._with_nu(label, tau, q, nu), perigee_m, apogee_m
 
 
 def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0) -> FloatArray:

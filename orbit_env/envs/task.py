@@ -724,7 +724,7 @@ def _point(state: AnyState) -> CurvePoint:
     """The state's place on the curves, nu known (no expm1 of tau)."""
     if isinstance(state, TaskState):
         return state.point
-    return CurvePoint(state.label, state.tau, state.period_s)._known_nu(state.nu)
+    return CurvePoint._with_nu(state.label, state.tau, state.period_s, state.nu)
 
 
 def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
