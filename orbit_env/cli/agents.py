@@ -50,6 +50,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         print(f"{PROG}: warning: {message}", file=sys.stderr)
 
     check_env_id(args.env)
+    if args.certify:
+        return _certify(args, say)
     policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say, warn=warn)
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
@@ -67,6 +69,15 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     else:
         found = [pair for pair in paired.values() if pair is not None]
         print(format_table(args.env, args.episodes, args.seed, table, found))
+    return 0
+
+
+def _certify(args: argparse.Namespace, say: Any) -> int:
+    from orbit_env.agents.certify import certify, format_certificate
+
+    certificate = certify(args.env, args.episodes, args.seed, progress=say)
+    summary = certificate.summary()
+    print(json.dumps(summary) if args.json else format_certificate(summary))
     return 0
 
 
@@ -104,6 +115,11 @@ def add_parsers(sub: Any) -> None:
         help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment)",
     )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
+    ev.add_argument(
+        "--certify",
+        action="store_true",
+        help="instead, search for plans that beat the DP policy on the episodes' starts; report the gap found",
+    )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
     ev.set_defaults(func=_cmd_evaluate)

@@ -1,0 +1,300 @@
+"""How far below the true optimum is the DP? A search for plans that beat it (``orbit-env evaluate --certify``).
+
+The DP (:mod:`orbit_env.agents.dp`) is the yardstick of every capture, but it is solved
+on a grid, so its policy can be beaten. This check searches, start by start, for an
+action sequence that earns more than the DP policy in the environment itself, and
+reports the gap it finds: a lower bound on the DP policy's distance to the optimum
+(no search proves there is no better plan; a found gap is real).
+
+For each of ``episodes`` seeded start orbits (those of ``orbit-env evaluate``):
+
+1. the DP policy plays the episode; its return is the reference and its actions the
+   first plan;
+2. every open-loop plan of burns on the first :data:`EARLY_STEPS` steps (all
+   combinations of :data:`EARLY_BURNS`), then coasting;
+3. hill climbing from the best plan so far: ``rounds`` rounds of ``perturbations``
+   random changes each (move a burn by up to :data:`MAX_SHIFT` steps, resize it, split
+   it over two steps, add one in the first :data:`ADD_WINDOW` steps, or drop one),
+   keeping a change that earns more.
+
+Every plan is scored in ``gymnasium.make_vec`` of the environment (the task model, no
+shortcut), all starts and candidates at once; the plans that beat the DP are replayed
+in ``gymnasium.make``, one environment each, and the replayed returns are the ones
+reported. The gap of a start is max(0, best plan - DP policy) in days of return.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium
+import numpy as np
+from numpy.typing import NDArray
+
+import orbit_env  # noqa: F401  (registers the environments)
+from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, task_of
+
+FloatArray = NDArray[np.float64]
+
+#: Steps at the start over which every combination of :data:`EARLY_BURNS` is tried.
+EARLY_STEPS = 3
+#: Burns tried in those steps [m/s] (the discrete variants use their own burn sizes).
+EARLY_BURNS = (0.0, 10.0, 20.0, 30.0, 50.0, 100.0)
+#: Largest move of a burn in time by one perturbation [steps].
+MAX_SHIFT = 10
+#: A perturbation adds a burn at one of the first this many steps.
+ADD_WINDOW = 60
+#: Gains below this [days] are ties: the DP's values are stored in steps of 0.01 day.
+TIE_DAYS = 0.01
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What the search found: per start, the DP policy's return and the best plan's (replayed)."""
+
+    env_id: str
+    seed: int
+    dp_returns: FloatArray
+    best_returns: FloatArray
+    perigee_km: FloatArray
+    apogee_km: FloatArray
+    wall_s: float
+    plans_scored: int
+    replay_max_error: float = field(default=0.0)
+
+    @property
+    def gaps(self) -> FloatArray:
+        """max(0, best plan - DP policy) per start [days]."""
+        return np.maximum(self.best_returns - self.dp_returns, 0.0)
+
+    def summary(self) -> dict[str, Any]:
+        """Mean and worst gap, where the worst is, and how many starts the DP lost by more than 0.1 day."""
+        gaps = self.gaps
+        worst = int(np.argmax(gaps))
+        return {
+            "env": self.env_id,
+            "seed": self.seed,
+            "episodes": int(gaps.size),
+            "mean_gap_days": float(gaps.mean()),
+            "worst_gap_days": float(gaps[worst]),
+            "worst_episode": worst,
+            "worst_start_km": [float(self.perigee_km[worst]), float(self.apogee_km[worst])],
+            "beaten_above_0.1_day": int(np.sum(gaps > 0.1)),
+            "beaten_at_all": int(np.sum(gaps > TIE_DAYS)),
+            "dp_mean_return": float(self.dp_returns.mean()),
+            "plans_scored": int(self.plans_scored),
+            "replay_max_error_days": float(self.replay_max_error),
+            "wall_s": float(self.wall_s),
+        }
+
+
+class _Plans:
+    """Scoring action plans (one row per start and candidate) in the vector env."""
+
+    def __init__(self, env_id: str, perigee_km: FloatArray, apogee_km: FloatArray) -> None:
+        self.env_id = env_id
+        base = task_of(env_id)
+        self.continuous = base.continuous
+        self.horizon = base.config.horizon_steps
+        self.max_burn = base.config.max_burn_m_s
+        self.sizes = np.asarray(base.config.burn_sizes_m_s, dtype=np.float64)
+        self.perigee_km = perigee_km
+        self.apogee_km = apogee_km
+        self.scored = 0
+
+    def actions(self, burns_m_s: FloatArray) -> Any:
+        """Env actions of burns [m/s] (discrete: the nearest size's index)."""
+        if self.continuous:
+            return (np.clip(burns_m_s / self.max_burn, 0.0, 1.0)[..., None]).astype(np.float32)
+        return np.abs(burns_m_s[..., None] - self.sizes).argmin(axis=-1).astype(np.int64)
+
+    def score(self, starts: NDArray[np.intp], burns_m_s: FloatArray, policy: Predictor | None = None) -> Any:
+        """Returns of the plans (rows of ``burns_m_s``, shape (k, horizon)) from ``starts``.
+
+        With ``policy`` the plans are ignored and the policy acts; then also its burns.
+        """
+        k = starts.size
+        env = gymnasium.make_vec(self.env_id, num_envs=k)
+        obs, _ = env.reset(seed=0, options={"perigee_km": self.perigee_km[starts], "apogee_km": self.apogee_km[starts]})
+        returns = np.zeros(k)
+        made = np.zeros((k, self.horizon))
+        running = np.ones(k, dtype=bool)
+        for t in range(self.horizon):
+            action = policy.predict(obs, deterministic=True)[0] if policy is not None else self.actions(burns_m_s[:, t])
+            obs, reward, terminated, truncated, info = env.step(action)
+            returns += np.where(running, reward, 0.0)
+            made[:, t] = np.where(running, info["burn_m_s"], 0.0)
+            running &= ~(terminated | truncated)
+            if not running.any():
+                break
+        env.close()
+        self.scored += k
+        return (returns, made) if policy is not None else returns
+
+    def replay(self, start: int, burns_m_s: FloatArray) -> float:
+        """The plan's return in ``gymnasium.make`` (one environment)."""
+        env = gymnasium.make(self.env_id)
+        env.reset(
+            seed=0, options={"perigee_km": float(self.perigee_km[start]), "apogee_km": float(self.apogee_km[start])}
+        )
+        total = 0.0
+        for t in range(self.horizon):
+            action = self.actions(burns_m_s[t : t + 1])[0]
+            _, reward, terminated, truncated, _ = env.step(action if self.continuous else int(action))
+            total += float(reward)
+            if terminated or truncated:
+                break
+        env.close()
+        return total
+
+
+def _early_plans(plans: _Plans) -> FloatArray:
+    """Every combination of early burns on the first :data:`EARLY_STEPS` steps, then coasting: (m, horizon)."""
+    burns = plans.sizes if not plans.continuous else np.asarray(EARLY_BURNS)
+    grids = np.meshgrid(*([burns] * EARLY_STEPS), indexing="ij")
+    early = np.stack([g.ravel() for g in grids], axis=1)
+    out = np.zeros((early.shape[0], plans.horizon))
+    out[:, :EARLY_STEPS] = early
+    return out
+
+
+def _perturb(plan: FloatArray, rng: np.random.Generator, plans: _Plans) -> FloatArray:
+    """One random change of a plan (see the module)."""
+    new = plan.copy()
+    burns = np.flatnonzero(new > 0.0)
+    kind = rng.integers(5) if burns.size else 3
+    step = plans.max_burn / 10.0 if plans.continuous else None
+    if kind == 0:  # move a burn
+        t = rng.choice(burns)
+        to = int(np.clip(t + rng.integers(-MAX_SHIFT, MAX_SHIFT + 1), 0, plans.horizon - 1))
+        new[t], new[to] = new[to], new[t]
+    elif kind == 1:  # resize a burn
+        t = rng.choice(burns)
+        if plans.continuous:
+            new[t] = np.clip(new[t] + rng.normal(0.0, step), 0.0, plans.max_burn)
+        else:
+            i = int(np.abs(plans.sizes - new[t]).argmin()) + rng.choice([-1, 1])
+            new[t] = plans.sizes[int(np.clip(i, 0, plans.sizes.size - 1))]
+    elif kind == 2:  # split a burn over it and the next step
+        t = rng.choice(burns)
+        if t + 1 < plans.horizon:
+            if plans.continuous:
+                part = new[t] * rng.uniform(0.2, 0.8)
+            else:
+                smaller = plans.sizes[(plans.sizes > 0) & (plans.sizes < new[t])]
+                part = new[t] - (rng.choice(smaller) if smaller.size else 0.0)
+            new[t] -= part
+            new[t + 1] += part
+            if not plans.continuous:
+                new[t + 1] = plans.sizes[np.abs(plans.sizes - new[t + 1]).argmin()]
+    elif kind == 3:  # add a burn early
+        t = rng.integers(min(ADD_WINDOW, plans.horizon))
+        positive = plans.sizes[plans.sizes > 0]
+        new[t] = rng.uniform(0.0, plans.max_burn) if plans.continuous else rng.choice(positive)
+    else:  # drop a burn
+        new[rng.choice(burns)] = 0.0
+    return new
+
+
+def certify(
+    env_id: str = "OrbitRaising-v0",
+    episodes: int = 1000,
+    seed: int = EVAL_SEED,
+    *,
+    rounds: int = 8,
+    perturbations: int = 24,
+    policy: Predictor | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> Certificate:
+    """Search for plans that beat the DP policy on ``episodes`` seeded starts (see the module).
+
+    Args:
+        env_id: A known-density environment (``OrbitRaising-v0``, ``OrbitRaisingContinuous-v0``).
+        episodes: Start orbits, those of ``orbit-env evaluate`` with the same seed.
+        seed: Seed of the starts.
+        rounds: Rounds of hill climbing.
+        perturbations: Random changes tried per start and round.
+        policy: The policy to certify (default: the env's DP policy).
+        progress: Called with a line of text as the search goes.
+
+    Raises:
+        ValueError: an unknown env, one whose density is not known (its optimum is the
+            oracle's), or counts below 1.
+    """
+    check_env_id(env_id)
+    base = task_of(env_id)
+    if base.density.scale_range[0] != base.density.scale_range[1] or base.density.varies:
+        raise ValueError(f"{env_id}: the certificate needs a known, constant density (the DP's task)")
+    if episodes < 1 or rounds < 0 or perturbations < 1:
+        raise ValueError("episodes and perturbations must be >= 1, rounds >= 0")
+    say = progress or (lambda text: None)
+    start_time = time.perf_counter()
+    env = gymnasium.make_vec(env_id, num_envs=episodes)
+    env.reset(seed=seed)
+    perigee_km = env.unwrapped.state["perigee_m"] / 1e3
+    apogee_km = env.unwrapped.state["apogee_m"] / 1e3
+    env.close()
+    plans = _Plans(env_id, perigee_km, apogee_km)
+    everyone = np.arange(episodes)
+    say("dp (solving and playing)")
+    dp_returns, dp_burns = plans.score(everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id))
+    best, best_returns = dp_burns.copy(), dp_returns.copy()
+    early = _early_plans(plans)
+    say(f"{early.shape[0]} early plans per start")
+    chunk = max(1, 65536 // early.shape[0])
+    for lo in range(0, episodes, chunk):
+        starts = everyone[lo : lo + chunk]
+        returns = plans.score(np.repeat(starts, early.shape[0]), np.tile(early, (starts.size, 1)))
+        returns = returns.reshape(starts.size, early.shape[0])
+        top = returns.argmax(axis=1)
+        better = returns[np.arange(starts.size), top] > best_returns[starts]
+        best[starts[better]] = early[top[better]]
+        best_returns[starts[better]] = returns[np.arange(starts.size), top][better]
+    rng = np.random.default_rng(seed)
+    for r in range(rounds):
+        candidates = np.stack([_perturb(best[i], rng, plans) for i in everyone for _ in range(perturbations)])
+        returns = plans.score(np.repeat(everyone, perturbations), candidates).reshape(episodes, perturbations)
+        top = returns.argmax(axis=1)
+        improved = returns[everyone, top] > best_returns
+        rows = everyone * perturbations + top
+        best[improved] = candidates[rows[improved]]
+        best_returns[improved] = returns[everyone, top][improved]
+        gap = np.maximum(best_returns - dp_returns, 0.0)
+        say(f"round {r + 1}/{rounds}: mean gap {gap.mean():.3f} day, worst {gap.max():.3f}")
+    # The plans that beat the DP, replayed one by one in gymnasium.make: the returns reported.
+    replay_error = 0.0
+    for i in np.flatnonzero(best_returns - dp_returns > TIE_DAYS):
+        replayed = plans.replay(int(i), best[i])
+        replay_error = max(replay_error, abs(replayed - best_returns[i]))
+        best_returns[i] = replayed
+    return Certificate(
+        env_id=env_id,
+        seed=seed,
+        dp_returns=dp_returns,
+        best_returns=best_returns,
+        perigee_km=perigee_km,
+        apogee_km=apogee_km,
+        wall_s=time.perf_counter() - start_time,
+        plans_scored=plans.scored,
+        replay_max_error=replay_error,
+    )
+
+
+def format_certificate(summary: dict[str, Any]) -> str:
+    """The certificate as text for people."""
+    return "\n".join(
+        [
+            f"{summary['env']}: a search for plans that beat the DP policy on {summary['episodes']} starts "
+            f"(seed {summary['seed']}), {summary['plans_scored']:,} plans scored in {summary['wall_s']:.0f} s",
+            f"DP policy's mean return {summary['dp_mean_return']:.3f} days",
+            f"gap found (best plan - DP policy): mean {summary['mean_gap_days']:.3f} day, "
+            f"worst {summary['worst_gap_days']:.3f} day (episode {summary['worst_episode']}, "
+            f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km)",
+            f"starts where the DP was beaten: {summary['beaten_at_all']} by more than {TIE_DAYS} day, "
+            f"{summary['beaten_above_0.1_day']} by more than 0.1 day",
+            f"winners replayed in gymnasium.make: largest difference {summary['replay_max_error_days']:.1e} day",
+        ]
+    )
