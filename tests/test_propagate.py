@@ -82,8 +82,14 @@ def test_season_matters_and_is_followed(msis):
 
 def test_lifetime_api_routes_and_errors(msis):
     activity = ConstantActivity(150.0, 150.0, 15.0)
-    with pytest.raises(ValueError, match="needs a solar activity"):
-        lifetime(300, 300, epoch="2021-01-01")
+    # A date and no activity: the shipped space-weather record (the real Sun of that date).
+    from orbit_env.decay.solar_record import load_record
+
+    by_date = lifetime(300, 300, epoch="2021-01-01", method="curves", satellite=SATELLITE).days
+    assert (
+        by_date
+        == lifetime(300, 300, activity=load_record(), epoch="2021-01-01", method="curves", satellite=SATELLITE).days
+    )
     with pytest.raises(ValueError, match="do not give an atmosphere"):
         lifetime(300, 300, activity=activity, rho100_kg_m3=1e-6)
     with pytest.raises(ValueError, match="direct method"):

@@ -7,7 +7,7 @@ This is the public edge, so heights are in km and every input is checked here
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -124,6 +124,9 @@ class LifetimeResult:
         perigee_velocity_m_s: Initial speed at perigee (Table II's v_pi).
         method: ``averaged``, ``curves`` or ``direct``.
         history: The decay history.
+        reentered: False when the satellite outlived the time-stepped propagation; ``days``,
+            ``revolutions`` and ``nu`` are then those reached (``max_years``), not a lifetime.
+        epoch_days: The start's unix days when the decay followed a date (else None).
     """
 
     perigee_km: float
@@ -134,6 +137,15 @@ class LifetimeResult:
     perigee_velocity_m_s: float
     method: str
     history: DecayHistory = field(repr=False)
+    reentered: bool = True
+    epoch_days: float | None = None
+
+    @property
+    def reentry_date(self) -> str | None:
+        """The re-entry, UTC, ISO 8601 to the minute (None without an epoch or without a re-entry)."""
+        if self.epoch_days is None or not self.reentered:
+            return None
+        return iso_datetime(self.epoch_days + self.days)
 
     @classmethod
     def from_si(
@@ -165,11 +177,20 @@ class LifetimeResult:
             "apogee_km": self.apogee_km,
             "nu": self.nu,
             "revolutions": self.revolutions,
-            "days": self.days,
-            "years": self.days / 365.25,
+            "days": self.days if self.reentered else None,
+            "years": self.days / 365.25 if self.reentered else None,
             "perigee_velocity_m_s": self.perigee_velocity_m_s,
             "method": self.method,
+            "reentered": self.reentered,
+            **({} if self.reentered else {"years_reached": self.days / 365.25}),
+            **({} if self.epoch_days is None else {"epoch": iso_datetime(self.epoch_days)}),
+            **({} if self.reentry_date is None else {"reentry_date": self.reentry_date}),
         }
+
+
+def iso_datetime(days: float) -> str:
+    """ISO 8601 UTC date and time to the minute of unix days: ``2003-01-21T05:10Z``."""
+    return str(np.datetime64(round(days * 1440.0), "m")) + "Z"
 
 
 def make_satellite(
@@ -377,11 +398,7 @@ def _lifetime_under_activity(
         t = np.append(result.history_days[inside], days)
         hp_path = np.append(result.history_perigee_m[inside, 0], result.history_perigee_m[-1, 0])
         ha_path = np.append(result.history_apogee_m[inside, 0], result.history_apogee_m[-1, 0])
-    if not reentered:
-        raise ValueError(
-            f"still in orbit after {model.max_years:g} years, where the time-stepped decay stops; "
-            "the lifetime is longer than that"
-        )
+    # Still up at max_years is a result (reentered False), reported as the years reached.
     # Revolutions: Int dt / P, trapezoidal over the recorded orbits (the period changes slowly).
     if np.all(np.isfinite(ha_path)):
         inverse_period = 1.0 / period_s(*elements_from_heights(hp_path, ha_path))
@@ -396,7 +413,9 @@ def _lifetime_under_activity(
         apogee_km=ha_path / 1e3,
         nu_remaining=np.linspace(nu, 0.0, t.size),
     )
-    return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
+    result = LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
+    epoch = model.start_days if model.follow_season else None
+    return replace(result, reentered=reentered, epoch_days=epoch)
 
 
 def check_rule(

@@ -4,26 +4,84 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from orbit_env.analysis.lifetime import LifetimeResult
+from orbit_env.decay.solar import SolarActivity
 from orbit_env.optional import pyplot
 
 
-def plot_history(result: LifetimeResult, path: str | Path) -> Path:
-    """Perigee and apogee against time for one decay."""
+def plot_history(
+    result: LifetimeResult,
+    path: str | Path,
+    *,
+    activity: SolarActivity | None = None,
+    height_offset_km: float = 0.0,
+    band_days: tuple[float, float] | None = None,
+) -> Path:
+    """Perigee and apogee against time for one decay; with a date, against the date, and the F10.7 beneath.
+
+    Args:
+        result: The decay.
+        path: The PNG to write.
+        activity: The solar activity the decay followed (drawn in a panel beneath when the
+            result has an epoch).
+        height_offset_km: Subtracted from the heights (the equatorial radius's 7.137 km when
+            heights are quoted above it).
+        band_days: A lifetime band (5th and 95th percentiles, days) to shade.
+    """
     plt = pyplot()
     history = result.history
-    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=120)
-    ax.plot(history.days, history.apogee_km, label="apogee")
-    ax.plot(history.days, history.perigee_km, label="perigee")
-    ax.set_xlabel("days since start")
-    ax.set_ylabel("height [km]")
-    ax.set_title(
-        f"{result.perigee_km:g} x {result.apogee_km:g} km: {result.days:.1f} days, "
-        f"{result.revolutions:.0f} revolutions ({result.method})",
-        fontsize=10,
+    dated = result.epoch_days is not None
+    if dated:
+        assert result.epoch_days is not None
+        x = (np.round((result.epoch_days + history.days) * 1440.0).astype(np.int64)).astype("datetime64[m]")
+    else:
+        x = history.days
+    panels = 2 if dated and activity is not None else 1
+    fig, axes = plt.subplots(
+        panels,
+        1,
+        figsize=(8, 4.5 + 2.0 * (panels - 1)),
+        dpi=120,
+        sharex=True,
+        squeeze=False,
+        gridspec_kw={"height_ratios": [3, 1.3][:panels]},
     )
+    ax = axes[0, 0]
+    ax.plot(x, history.apogee_km - height_offset_km, label="apogee")
+    ax.plot(x, history.perigee_km - height_offset_km, label="perigee")
+    ax.set_ylabel("height [km]")
+    if result.reentered:
+        what = f"{result.days:.1f} days"
+        if result.reentry_date is not None:
+            what += f", re-entry {result.reentry_date}"
+    else:
+        what = f"still in orbit after {result.days / 365.25:.0f} years"
+    heights = f"{result.perigee_km - height_offset_km:.6g} x {result.apogee_km - height_offset_km:.6g} km"
+    ax.set_title(f"{heights}: {what} ({result.method})", fontsize=10)
+    if band_days is not None:
+        low, high = band_days
+        if dated:
+            assert result.epoch_days is not None
+            low_x, high_x = (np.datetime64(round((result.epoch_days + d) * 1440.0), "m") for d in (low, high))
+        else:
+            low_x, high_x = low, high
+        ax.axvspan(low_x, high_x, color="tab:red", alpha=0.15, label="re-entry, 5-95%")
     ax.grid(alpha=0.3)
     ax.legend()
+    if panels == 2:
+        assert activity is not None and result.epoch_days is not None
+        t = result.epoch_days + np.linspace(0.0, float(history.days[-1]), 2000)
+        f107, f107a, _ = activity.indices(t)
+        sun = axes[1, 0]
+        t_x = (np.round(t * 1440.0).astype(np.int64)).astype("datetime64[m]")
+        sun.plot(t_x, f107, lw=0.5, color="0.6", label="F10.7, daily")
+        sun.plot(t_x, f107a, lw=1.2, color="tab:orange", label="81-day mean")
+        sun.set_ylabel("F10.7 [sfu]")
+        sun.grid(alpha=0.3)
+        sun.legend(fontsize=8)
+    axes[-1, 0].set_xlabel("date (UTC)" if dated else "days since start")
     fig.tight_layout()
     out = Path(path)
     fig.savefig(out)

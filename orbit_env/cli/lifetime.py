@@ -207,7 +207,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         **drag_report,
     )
     if orbit.elements is not None:
-        summary.update(orbit_inputs.elements_report(orbit.elements))
+        summary.update(orbit_inputs.elements_report(orbit.elements, result))
     rule = None
     if args.rule is not None:
         rule = check_rule(
@@ -225,11 +225,11 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             dv_m_s=float(rule.dv_m_s[0]),
         )
     if args.trajectory:
-        write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset))
+        write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset, result.epoch_days))
     if args.plot:
         from orbit_env.analysis.plots import plot_history
 
-        plot_history(result, args.plot)
+        plot_history(result, args.plot, activity=scenario.activity, height_offset_km=offset)
     if args.json:
         summary["atmosphere"] = _atmosphere(args, scenario)
         print(_json(summary))
@@ -241,7 +241,12 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     print(f"atmosphere         {_atmosphere(args, scenario)}")
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")
-    print(f"lifetime           {result.days:.2f} days ({result.days / 365.25:.2f} years)")
+    if result.reentered:
+        print(f"lifetime           {result.days:.2f} days ({result.days / 365.25:.2f} years)")
+        if summary.get("reentry_date"):
+            print(f"re-entry           {summary['reentry_date']}")
+    else:
+        print(f"lifetime           still in orbit after {result.days / 365.25:.0f} years (where the propagation stops)")
     print(f"perigee velocity   {result.perigee_velocity_m_s:.1f} m/s")
     print(f"method             {result.method}")
     if rule is not None:

@@ -230,14 +230,19 @@ def sphere_scenario(scenario: Any, reference: str, inclination_deg: float) -> An
     return replace(scenario, rho0_kg_m3=law.rho0_kg_m3, h0_m=law.h0_m)
 
 
-def elements_report(elements: Any) -> dict[str, Any]:
-    """What JSON says about an element set."""
+def elements_report(elements: Any, result: Any = None) -> dict[str, Any]:
+    """What JSON says about an element set (and the re-entry date from its epoch, if the decay had none)."""
+    from orbit_env.analysis.lifetime import iso_datetime
+
     report: dict[str, Any] = {
         "semi_major_axis_km": elements.semi_major_axis_km,
         "eccentricity": elements.eccentricity,
     }
     if elements.epoch_days is not None:
         report.update(name=elements.name, epoch=elements.epoch_iso)
+        if result is not None and result.epoch_days is None and result.reentered:
+            # A fixed atmosphere (no date in the decay): the element set's epoch still dates the re-entry.
+            report["reentry_date"] = iso_datetime(elements.epoch_days + result.days)
     return report
 
 
@@ -278,12 +283,16 @@ def satellite_line(satellite: Satellite, source: str, report: dict[str, Any]) ->
     return text
 
 
-def history_rows(history: Any, offset: float) -> list[dict[str, float]]:
-    """The decay history's rows with heights above the reference."""
-    rows = history.rows()
+def history_rows(history: Any, offset: float, epoch_days: float | None = None) -> list[dict[str, Any]]:
+    """The decay history's rows with heights above the reference (and the UTC date, with an epoch)."""
+    from orbit_env.analysis.lifetime import iso_datetime
+
+    rows: list[dict[str, Any]] = history.rows()
     for row in rows:
         row["perigee_km"] -= offset
         row["apogee_km"] -= offset
+    if epoch_days is not None:
+        rows = [{"date": iso_datetime(epoch_days + row["days"]), **row} for row in rows]
     return rows
 
 

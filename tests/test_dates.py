@@ -1,0 +1,62 @@
+"""Dates on lifetimes (re-entry date, dated history and plot) and lives longer than the propagation."""
+
+import csv
+import functools
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pymsis")
+
+from orbit_env.analysis import lifetime as lifetime_module
+from orbit_env.cli import main
+from orbit_env.decay.chunked import SolarDecayModel
+from orbit_env.decay.solar import unix_days
+
+ORBIT = ["lifetime", "--perigee", "300", "--apogee", "300", "--inclination", "51.6"]
+CUBESAT = ["--mass", "4", "--area", "0.03", "--cx", "2.2"]
+
+
+def run(capsys, *argv):
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_reentry_date_is_the_epoch_plus_the_lifetime(capsys, tmp_path):
+    trajectory = tmp_path / "t.csv"
+    status, out, _ = run(capsys, *ORBIT, *CUBESAT, "--epoch", "2015-05-01", "--json", "--trajectory", str(trajectory))
+    result = json.loads(out)
+    assert status == 0 and result["reentered"] is True and result["epoch"] == "2015-05-01T00:00Z"
+    reentry = unix_days("2015-05-01") + result["days"]
+    assert result["reentry_date"] == str(np.datetime64(round(reentry * 1440), "m")) + "Z"
+    rows = list(csv.DictReader(trajectory.open()))
+    assert rows[0]["date"] == "2015-05-01T00:00Z" and rows[-1]["date"] == result["reentry_date"]
+    # Days and dates agree on every row, to the minute.
+    for row in rows:
+        assert unix_days(row["date"].rstrip("Z")) == pytest.approx(
+            unix_days("2015-05-01") + float(row["days"]), abs=1e-3
+        )
+
+
+def test_outliving_the_propagation_is_a_result(capsys, monkeypatch):
+    # A 0.3-year cap stands in for the 200 years (same code path, a test's time).
+    short = functools.partial(SolarDecayModel, max_years=0.3)
+    monkeypatch.setattr(lifetime_module, "SolarDecayModel", short)
+    argv = ["lifetime", "--perigee", "500", "--apogee", "500", *CUBESAT, "--epoch", "2015-05-01"]
+    status, out, _ = run(capsys, *argv, "--json")
+    result = json.loads(out)
+    assert status == 0
+    assert result["reentered"] is False and result["days"] is None and result["years"] is None
+    assert result["years_reached"] == pytest.approx(0.3, abs=20 / 365.25)  # a whole number of 20-day chunks
+    assert "reentry_date" not in result
+    status, out, _ = run(capsys, *argv)
+    assert status == 0 and "still in orbit after 0 years" in out
+
+
+def test_plot_carries_dates_and_the_sun(capsys, tmp_path):
+    pytest.importorskip("matplotlib")
+    path = tmp_path / "decay.png"
+    status, _, _ = run(capsys, *ORBIT, *CUBESAT, "--epoch", "2015-05-01", "--plot", str(path))
+    assert status == 0 and path.stat().st_size > 10_000
