@@ -153,6 +153,25 @@ def test_fit_density_reentry_on_the_observations_axis(capsys, tmp_path):
     assert status == 2 and "'date' and 'days'" in err and err.count("\n") == 1
 
 
+def test_fit_density_refuses_a_scale_no_atmosphere_has(capsys, tmp_path):
+    observations = tmp_path / "obs.csv"
+    observations.write_text("days,perigee_km,apogee_km\n0,400,420\n")
+    # Down from 400 km in an hour: a thousand times any density there, not a measurement.
+    status, out, err = run(capsys, "fit-density", observations, "--reentry", "0.04")
+    assert status == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith("orbit-env: error: the fitted density scale, ")
+    assert "is outside 0.001 to 1000: the data do not fit this satellite in this atmosphere" in err
+
+
+def test_argparse_never_stores_an_empty_list(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["lifetime", "--perigee", "300", "--apogee=--"])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and err == (
+        "orbit-env lifetime: error: argument --apogee: expected one argument, got '--' (see --help)\n"
+    )
+
+
 def test_fit_density_errors_name_the_file_and_line(capsys, tmp_path):
     observations = tmp_path / "obs.csv"
     observations.write_text("days,perigee_km,apogee_km\n0,300,320\n\n1,abc,310\n")
@@ -239,7 +258,8 @@ def test_no_nan_in_the_trajectory_under_changing_activity(capsys, tmp_path):
     assert status == 0
     rows = list(csv.DictReader(open(trajectory)))
     assert len(rows) > 2
-    values = np.array([[float(v) for v in row.values()] for row in rows])
+    numbers = ("revolutions", "days", "perigee_km", "apogee_km", "nu_remaining")
+    values = np.array([[float(row[key]) for key in numbers] for row in rows])
     assert np.isfinite(values).all()
     perigee, apogee = values[:, 2], values[:, 3]
     assert np.all(perigee <= apogee + 1e-9)

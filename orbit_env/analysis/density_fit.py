@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.analysis.scenario import Scenario
+from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario
 from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import read_csv
@@ -277,8 +277,10 @@ def fit_density_scale(
             raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
         check_number(reentry_sigma_days, "reentry_sigma_days", unit="days", low=0.0)
         check_number(height_sigma_km, "height_sigma_km", unit="km", low=0.0)
-        return _fit_reentry(
-            float(hp[0]), float(ha[0]), dt_days, c, scenario, inclination_deg, reentry_sigma_days, height_sigma_km
+        return _plausible(
+            _fit_reentry(
+                float(hp[0]), float(ha[0]), dt_days, c, scenario, inclination_deg, reentry_sigma_days, height_sigma_km
+            )
         )
     if scenario.time_varying:
         raise ValueError(
@@ -313,13 +315,32 @@ def fit_density_scale(
     sigma2 = float(residuals @ residuals) / dof
     jac = solution.jac
     covariance = sigma2 * np.linalg.pinv(jac.T @ jac)
-    return DensityFit(
-        scale=float(math.exp(solution.x[0])),
-        sigma_log=float(math.sqrt(max(covariance[0, 0], 0.0))),
-        dof=dof,
-        description=f"{n} orbits over {observations.days[-1] - observations.days[0]:.4g} days ({observations.source})",
-        residual_rms_km=float(math.sqrt(float(residuals @ residuals) / residuals.size)),
+    return _plausible(
+        DensityFit(
+            scale=float(math.exp(solution.x[0])),
+            sigma_log=float(math.sqrt(max(covariance[0, 0], 0.0))),
+            dof=dof,
+            description=f"{n} orbits over {observations.days[-1] - observations.days[0]:.4g} days "
+            f"({observations.source})",
+            residual_rms_km=float(math.sqrt(float(residuals @ residuals) / residuals.size)),
+        )
     )
+
+
+def _plausible(fit: DensityFit) -> DensityFit:
+    """The fit, if its scale is one an atmosphere can have; else an error saying what that means.
+
+    A scale outside :data:`~orbit_env.analysis.scenario.DENSITY_SCALE_RANGE` (or not finite)
+    says that the data do not fit this satellite in this atmosphere: a wrong mass or area,
+    heights or times mistyped, or an orbit raised by a burn between two observations.
+    """
+    low, high, _ = DENSITY_SCALE_RANGE
+    if not (math.isfinite(fit.scale) and math.isfinite(fit.sigma_log) and low <= fit.scale <= high):
+        raise ValueError(
+            f"the fitted density scale, {fit.scale:.3g}, is outside {low:g} to {high:g}: the data do not fit "
+            "this satellite in this atmosphere (check its mass and area, the heights and the times)"
+        )
+    return fit
 
 
 def _initial_log_scale(curves: UniversalCurves, hp: FloatArray, ha: FloatArray, gc_dt: FloatArray) -> float:

@@ -24,6 +24,12 @@ class Parser(argparse.ArgumentParser):
         """Exit with status 2 and the message on one line."""
         self.exit(2, f"{self.prog}: error: {message} (see --help)\n")
 
+    def _get_values(self, action: argparse.Action, arg_strings: list[str]) -> Any:
+        # argparse drops a value "--" ("--apogee=--") and stores an empty list as the flag's value.
+        if action.nargs is None and action.option_strings and arg_strings == ["--"]:
+            self.error(f"argument {'/'.join(action.option_strings)}: expected one argument, got '--'")
+        return super()._get_values(action, arg_strings)
+
 
 def check_finite(values: dict[str, Any], what: str) -> None:
     """Refuse to output a NaN or an infinity: an error names the value, rather than a file or line holding it.
