@@ -207,6 +207,7 @@ def certify(
     rounds: int = 8,
     perturbations: int = 24,
     policy: Predictor | None = None,
+    dp_lookahead: int = 1,
     progress: Callable[[str], None] | None = None,
 ) -> Certificate:
     """Search for plans that beat the DP policy on ``episodes`` seeded starts (see the module).
@@ -218,6 +219,7 @@ def certify(
         rounds: Rounds of hill climbing.
         perturbations: Random changes tried per start and round.
         policy: The policy to certify (default: the env's DP policy).
+        dp_lookahead: The DP policy's ``lookahead`` (:class:`orbit_env.agents.dp.DPPolicy`).
         progress: Called with a line of text as the search goes.
 
     Raises:
@@ -240,7 +242,9 @@ def certify(
     plans = _Plans(env_id, perigee_km, apogee_km)
     everyone = np.arange(episodes)
     say("dp (solving and playing)")
-    dp_returns, dp_burns = plans.score(everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id))
+    dp_returns, dp_burns = plans.score(
+        everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id, dp_lookahead)
+    )
     best, best_returns = dp_burns.copy(), dp_returns.copy()
     early = _early_plans(plans)
     say(f"{early.shape[0]} early plans per start")

@@ -330,6 +330,7 @@ def all_policies(
     include_dp: bool = True,
     progress: Callable[[str], None] | None = None,
     warn: Callable[[str], None] | None = None,
+    dp_lookahead: int = 1,
 ) -> dict[str, Predictor]:
     """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in :data:`POLICY_ORDER`.
 
@@ -342,7 +343,7 @@ def all_policies(
     if include_dp:
         if progress is not None:
             progress("dp (solving)")
-        policies["dp"] = dp_policy(env_id)
+        policies["dp"] = dp_policy(env_id, dp_lookahead)
     if learned is not None:
         policies[learned[0]] = learned[1]
     return {name: policies[name] for name in POLICY_ORDER if name in policies}
@@ -409,11 +410,12 @@ class OracleDP:
         return actions, state
 
 
-def dp_policy(env_id: str) -> Predictor:
+def dp_policy(env_id: str, lookahead: int = 1) -> Predictor:
     """The optimum for ``env_id``: DP on the known density, its continuous form, or the oracle.
 
     The continuous variant's DP chooses among burns spaced by :data:`CONTINUOUS_DP_STEP_M_S`:
     a lower bound on its optimum, converging as the spacing shrinks (see the constant).
+    ``lookahead``: see :class:`orbit_env.agents.dp.DPPolicy` (not for the oracle).
     """
     from orbit_env.agents.dp import DPPolicy
 
@@ -423,9 +425,9 @@ def dp_policy(env_id: str) -> Predictor:
     if base.continuous:
         sizes = continuous_dp_burns(base.config.max_burn_m_s)
         fine = dataclasses.replace(base.config, burn_sizes_m_s=sizes)
-        policy = DPPolicy(fine, density_scale=base.density.nominal_scale)
+        policy = DPPolicy(fine, density_scale=base.density.nominal_scale, lookahead=lookahead)
         return ContinuousFromDiscrete(policy, sizes, base.config.max_burn_m_s)
-    return DPPolicy(base.config, density_scale=base.density.nominal_scale)
+    return DPPolicy(base.config, density_scale=base.density.nominal_scale, lookahead=lookahead)
 
 
 #: Spacing of the burn sizes the DP of the continuous variant chooses from [m/s]. Measured on the

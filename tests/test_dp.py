@@ -220,3 +220,18 @@ def test_invalid_observations_and_states_raise(solution):
         solution.value(300.0, 600.0, -1.0, 10)
     with pytest.raises(ValueError, match="apogee"):
         solution.value(300.0, 4500.0, 100.0, 10)
+
+
+def test_a_two_step_lookahead_acts_and_checks_its_argument():
+    policy = dp.DPPolicy(CONFIG, grid=GRID, lookahead=2)
+    one = dp.DPPolicy(CONFIG, grid=GRID)
+    env = gym.make_vec("OrbitRaising-v0", num_envs=16, config=CONFIG)
+    obs, _ = env.reset(seed=4)
+    actions, _ = policy.predict(obs)
+    assert actions.shape == (16,) and actions.dtype == np.int64
+    # Where burning cannot pay (an empty tank reads 0 delta-v), both coast.
+    empty = obs.copy()
+    empty[:, 2] = 0.0
+    np.testing.assert_array_equal(policy.predict(empty)[0], one.predict(empty)[0])
+    with pytest.raises(ValueError, match="lookahead=3 is invalid"):
+        dp.DPPolicy(CONFIG, grid=GRID, lookahead=3)

@@ -52,7 +52,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     check_env_id(args.env)
     if args.certify:
         return _certify(args, say)
-    policies = all_policies(args.env, model_path=args.model, include_dp=not args.no_dp, progress=say, warn=warn)
+    policies = all_policies(
+        args.env,
+        model_path=args.model,
+        include_dp=not args.no_dp,
+        progress=say,
+        warn=warn,
+        dp_lookahead=args.dp_lookahead,
+    )
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
         plot_returns(results, args.env, args.plot)
@@ -75,7 +82,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 def _certify(args: argparse.Namespace, say: Any) -> int:
     from orbit_env.agents.certify import certify, format_certificate
 
-    certificate = certify(args.env, args.episodes, args.seed, progress=say)
+    certificate = certify(args.env, args.episodes, args.seed, dp_lookahead=args.dp_lookahead, progress=say)
     summary = certificate.summary()
     print(json.dumps(summary) if args.json else format_certificate(summary))
     return 0
@@ -115,6 +122,13 @@ def add_parsers(sub: Any) -> None:
         help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment)",
     )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
+    ev.add_argument(
+        "--dp-lookahead",
+        type=int,
+        choices=(1, 2),
+        default=1,
+        help="steps the DP policy takes exactly before reading its grid (default 1; 2 is closer to the optimum)",
+    )
     ev.add_argument(
         "--certify",
         action="store_true",
