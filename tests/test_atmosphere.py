@@ -50,11 +50,15 @@ def test_exponential_model_and_plain_functions_plug_in():
         as_atmosphere(42)
 
 
+#: The paper law's bounds on rho(100 km), as the error gives them.
+_RHO100 = "1e-08 to 0.0001 kg/m^3 (every model and season puts 100 km between 2e-7 and 2e-6 kg/m^3)"
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"rho100_kg_m3": -1.0}, "rho100_kg_m3=-1 is out of range; allowed: above 0 kg/m^3"),
-        ({"rho100_kg_m3": float("nan")}, "rho100_kg_m3=nan is not a finite number; allowed: above 0 kg/m^3"),
+        ({"rho100_kg_m3": -1.0}, f"rho100_kg_m3=-1 is out of range; allowed: {_RHO100}"),
+        ({"rho100_kg_m3": float("nan")}, f"rho100_kg_m3=nan is not a finite number; allowed: {_RHO100}"),
         ({"scale": 0.0}, "scale=0 is out of range; allowed: above 0"),
     ],
 )

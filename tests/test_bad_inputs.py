@@ -216,6 +216,45 @@ def test_implausible_inputs_are_refused_with_their_bounds_and_why(capsys, argv, 
     assert err.startswith(f"orbit-env: error: {start}") and err.count("\n") == 1
 
 
+#: An exponential law whose 1 km scale height leaves no air at 1100 km.
+_SEA_LEVEL_KM_LAW = ("--rho0", "1e-13", "--h0-km", "0", "--scale-height-km", "1")
+
+
+@pytest.mark.parametrize(
+    ("argv", "start"),
+    [
+        # 1100 x 4000 km, the heaviest load, a thousandth of the density: 6e8 years (lifetime ~ G/F / rho).
+        (
+            ["--perigee", "1100", "--apogee", "4000", "--mass-per-area", "1e5", "--density-scale", "0.001"],
+            "the lifetime comes out as 6.08e+08 years, more than 1,000,000: ",
+        ),
+        # exp(-1100 km / 1 km) underflows: no drag at all.
+        (
+            [*("--perigee", "1100", "--apogee", "4000", "--atmosphere", "exponential"), *_SEA_LEVEL_KM_LAW],
+            "the density at the perigee is 0 kg/m^3 in this atmosphere (it underflows)",
+        ),
+        (
+            ["--perigee", "50000", "--apogee", "50000", "--rho100", "1e-7", "--rotating-atmosphere"],
+            "the averaged equations could not follow this decay to re-entry",
+        ),
+    ],
+)
+def test_lifetimes_beyond_any_model_are_refused(capsys, argv, start):
+    status, out, err = run(capsys, "lifetime", *argv)
+    assert status == 2 and out == "" and err.startswith(f"orbit-env: error: {start}") and err.count("\n") == 1
+
+
+def test_a_batch_row_beyond_any_model_gets_its_line(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_text("perigee_km,apogee_km,mass_per_area_kg_m2\n\n1100,4000,90000\n300,400,50\n")
+    out = tmp_path / "out.csv"
+    status, _, _ = run(capsys, "lifetime", "--batch", sats, "--out", out, "--density-scale", "0.001", "--no-progress")
+    assert status == 1
+    far, near = csv.DictReader(open(out))
+    assert far["days"] == "" and far["status"].startswith("line 3: the lifetime comes out as ")
+    assert near["status"] == "ok" and 0 < float(near["years"]) < 1e6
+
+
 def test_the_exponential_law_defaults_to_orbital_heights_and_says_so(capsys):
     status, out, _ = run(capsys, *ORBIT, "--atmosphere", "exponential", "--json")
     assert status == 0

@@ -177,7 +177,11 @@ _LAW = ["--rho0", "1.3", "--h0-km", "0"]
             "--cx -1 is out of range; allowed: above 0 and at most 10 "
             "(free-molecular drag coefficients are 2 to 4 for any shape)",
         ),
-        ([*_ORBIT, "--rho100", "-3"], "--rho100 -3 is out of range; allowed: above 0 kg/m^3"),
+        (
+            [*_ORBIT, "--rho100", "-3"],
+            "--rho100 -3 is out of range; allowed: 1e-08 to 0.0001 kg/m^3 "
+            "(every model and season puts 100 km between 2e-7 and 2e-6 kg/m^3)",
+        ),
         (
             [*_ORBIT, "--density-scale", "0"],
             "--density-scale 0 is out of range; allowed: 0.001 to 1000 "

@@ -48,6 +48,8 @@ from orbit_env.analysis.lifetime import (
     DRAG_PARAMETER_RANGE_M2_KG,
     MASS_PER_AREA_RANGE_KG_M2,
     MASS_RANGE_KG,
+    MAX_LIFETIME_YEARS,
+    check_lifetime_days,
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
@@ -61,6 +63,9 @@ INCLINATION_STEP_DEG = 1.0
 #: Satellites per progress-bar step on the fixed-profile path.
 BLOCK = 20_000
 _ID_COLUMNS = ("name", "id")
+#: Key of a row's physical line in the rows of :func:`read_batch` (a header name is stripped of
+#: spaces, so no column can be called this).
+LINE_KEY = " line"
 
 
 @dataclass(frozen=True)
@@ -126,7 +131,7 @@ def read_batch(
     table.require("perigee_km", "apogee_km", what="the batch file")
     if not table.rows:
         raise ValueError(f"{table.source}: the batch file has a header but no rows")
-    rows = [row.cells for row in table.rows]
+    rows = [{**row.cells, LINE_KEY: str(row.line)} for row in table.rows]
     lines = [row.line for row in table.rows]
     n = len(rows)
     hp_km, ha_km, c, inc = (np.full(n, np.nan) for _ in range(4))
@@ -214,6 +219,12 @@ def batch_lifetimes(
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:
             status[i] = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"
+    for i in np.flatnonzero(ok & reentered & ~(days <= MAX_LIFETIME_YEARS * 365.25)):
+        try:
+            check_lifetime_days(float(days[i]))
+        except ValueError as error:
+            line = rows[i].get(LINE_KEY)
+            status[i] = f"line {line}: {error}" if line else str(error)
     records = []
     for i, row in enumerate(rows):
         record: dict[str, Any] = {key: row[key] for key in _ID_COLUMNS if key in row}

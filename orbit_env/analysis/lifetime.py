@@ -44,6 +44,9 @@ MASS_PER_AREA_RANGE_KG_M2 = (
     "from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2",
 )
 DRAG_PARAMETER_RANGE_M2_KG = (1e-5, 1e3, "c_x A / m within the bounds of c_x and of mass / area")
+#: Longest lifetime reported [years]; beyond it a number would claim more than any atmosphere
+#: model (or the solar cycles it averages) can say.
+MAX_LIFETIME_YEARS = 1e6
 
 
 @dataclass(frozen=True)
@@ -312,6 +315,12 @@ def lifetime(
         raise ValueError("rho100_kg_m3 applies to the paper's atmosphere only; scale your own model instead")
     elif scale != 1.0:
         raise ValueError("density_scale applies to the paper's atmosphere only; scale your own model instead")
+    rho_perigee = float(np.asarray(atmosphere.density_kg_m3(hp_m)))
+    if not (math.isfinite(rho_perigee) and rho_perigee > 0.0):
+        raise ValueError(
+            f"the density at the perigee is {rho_perigee:g} kg/m^3 in this atmosphere (it underflows): no drag, "
+            "no re-entry; check the law's values"
+        )
     model = DecayModel(atmosphere, rotating_atmosphere=rotating_atmosphere, inclination_deg=inclination_deg)
     per_nu = satellite.revolutions_per_nu
     to_days = 1.0 / (float(nu_per_revolution(satellite.drag_parameter_m2_kg)) * SECONDS_PER_DAY)
@@ -368,7 +377,21 @@ def lifetime(
             nu_remaining=nu - path.nu,
         )
         revolutions, days = nu * per_nu, weighted * to_days
-    return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
+    return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, check_lifetime_days(days), method, history)
+
+
+def check_lifetime_days(days: float) -> float:
+    """A lifetime the models can answer for, in days; else an error saying how long it came out.
+
+    Raises:
+        ValueError: ``days`` is not finite or exceeds :data:`MAX_LIFETIME_YEARS`.
+    """
+    if not (math.isfinite(days) and days <= MAX_LIFETIME_YEARS * 365.25):
+        raise ValueError(
+            f"the lifetime comes out as {days / 365.25:.3g} years, more than {MAX_LIFETIME_YEARS:,.0f}: drag "
+            "hardly touches this orbit, and no atmosphere model holds that long"
+        )
+    return days
 
 
 def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:

@@ -23,7 +23,7 @@ from orbit_env.analysis.lifetime import (
     make_satellite,
 )
 from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
-from orbit_env.checks import check_date
+from orbit_env.checks import check_date, check_number
 from orbit_env.cli import orbit_inputs
 from orbit_env.cli.common import PROG, check_finite, flag, given, number, write_csv
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
@@ -151,6 +151,12 @@ def _warn_solar_table(scenario: Scenario, last_day: float) -> None:
         )
 
 
+def _check_inclination(args: argparse.Namespace) -> None:
+    """Check --inclination before anything uses it (a batch's rows and the height conversions do)."""
+    if args.inclination is not None:
+        check_number(args.inclination, "inclination_deg", unit="deg", low=0.0, high=180.0)
+
+
 def _json(summary: dict[str, Any]) -> str:
     """One JSON object; NaN and infinities are refused here rather than printed (they are not JSON)."""
     check_finite(summary, "the result")
@@ -159,6 +165,7 @@ def _json(summary: dict[str, Any]) -> str:
 
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
+    _check_inclination(args)
     orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
     satellite, drag_source, drag_report = orbit_inputs.satellite_from_args(args, orbit, scenario)
@@ -318,6 +325,7 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     from orbit_env.analysis.density_fit import fit_density_scale, read_observations, reentry_days
 
     args.inclination_defaulted = args.inclination is None
+    _check_inclination(args)
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:

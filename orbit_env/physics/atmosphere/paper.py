@@ -44,6 +44,10 @@ def paper_delta(altitude_m: ArrayLike) -> NDArray[np.float64]:
     return np.exp(_LOG_CHI[band] - _K[band] * np.log1p((y - _Y0_M[band]) / _A_M[band]))
 
 
+#: Bounds of the density at 100 km [kg/m^3], and why (outside them the decay equations break down).
+RHO100_RANGE_KG_M3 = (1e-8, 1e-4, "every model and season puts 100 km between 2e-7 and 2e-6 kg/m^3")
+
+
 @dataclass(frozen=True)
 class PaperAtmosphere:
     """The paper's density law, Eq. (1.1) with Table 1.
@@ -59,7 +63,8 @@ class PaperAtmosphere:
     scale: float = 1.0
 
     def __post_init__(self) -> None:
-        check_number(self.rho100_kg_m3, "rho100_kg_m3", unit="kg/m^3", low=0.0, low_inclusive=False)
+        low, high, why = RHO100_RANGE_KG_M3
+        check_number(self.rho100_kg_m3, "rho100_kg_m3", unit="kg/m^3", low=low, high=high, why=why)
         check_number(self.scale, "scale", low=0.0, low_inclusive=False)
 
     def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
