@@ -88,6 +88,29 @@ def _certify(args: argparse.Namespace, say: Any) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from orbit_env.agents.sweep import format_table, sweep
+
+    algos = [a.strip() for a in args.algos.split(",") if a.strip()]
+    result = sweep(
+        args.env,
+        algos,
+        args.seeds,
+        args.timesteps,
+        args.out,
+        address=args.address,
+        episodes=args.episodes,
+        include_dp=not args.no_dp,
+        progress=lambda text: print(f"  {text} ...", file=sys.stderr),
+    )
+    print(format_table(args.env, result["table"], args.timesteps))
+    print(
+        f"{len(result['trials'])} trials on {result['cores']} cores in {result['sweep_wall_s']:.0f} s; "
+        f"{args.out}/results.json"
+    )
+    return 0
+
+
 def add_parsers(sub: Any) -> None:
     """The ``train`` and ``evaluate`` commands."""
     tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
@@ -137,3 +160,20 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
     ev.set_defaults(func=_cmd_evaluate)
+
+    sw = sub.add_parser("sweep", help="algorithms x seeds as Ray Tune trials: a table of baselines with error bars")
+    sw.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
+    sw.add_argument("--algos", default="ppo,a2c", metavar="A,B", help="ppo, a2c, dqn, sac, td3, ppo_recipe")
+    sw.add_argument("--seeds", type=positive_int, default=5, metavar="N", help="seeds 0..N-1 (default 5)")
+    sw.add_argument("--timesteps", type=positive_int, default=100_000, metavar="T", help="per trial")
+    sw.add_argument("--out", required=True, metavar="DIR", help="results.json, the models, Ray's state (resumable)")
+    sw.add_argument("--address", metavar="RAY_ADDRESS", help="a Ray cluster (default: a local Ray)")
+    sw.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=EVAL_EPISODES,
+        metavar="N",
+        help=f"evaluation episodes per trial (default {EVAL_EPISODES})",
+    )
+    sw.add_argument("--no-dp", action="store_true", help="no capture (skips the DP's solve)")
+    sw.set_defaults(func=_cmd_sweep)

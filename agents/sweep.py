@@ -1,0 +1,267 @@
+"""Baselines across algorithms and seeds as Ray Tune trials (``orbit-env sweep``).
+
+Each trial trains one Stable-Baselines3 algorithm with one seed on the numpy vector
+environment, saves the model and scores it on the evaluation episodes of
+``orbit-env evaluate`` (the plain reward; capture against the DP optimum, as there).
+The trials run on Ray Tune (``pip install 'orbit-env[cluster]'``): a local Ray by
+default, a cluster by its address. A sweep interrupted in the middle continues where
+it stopped when run again with the same ``--out`` (finished trials are kept).
+
+Algorithms: ``ppo``, ``a2c``, ``dqn`` (discrete actions), ``sac``, ``td3`` (continuous)
+with Stable-Baselines3's defaults, and ``ppo_recipe``, the project's recipe (the TOML
+file of the shipped agent of the environment, :mod:`orbit_env.agents.train`).
+
+The table reports, per algorithm, rliable's interquartile mean (IQM) of the capture
+over the seeds, with a 95% bootstrap confidence interval (seeds resampled with
+replacement, the stratified bootstrap of rliable for one task), and the mean optimality
+gap 1 - capture.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: The algorithms a sweep runs, and the action spaces each takes.
+SWEEP_ALGOS = {
+    "ppo": ("discrete", "continuous"),
+    "a2c": ("discrete", "continuous"),
+    "dqn": ("discrete",),
+    "sac": ("continuous",),
+    "td3": ("continuous",),
+    "ppo_recipe": ("discrete", "continuous"),
+}
+#: The recipe (training config) of each environment's shipped agent.
+RECIPES = {
+    "OrbitRaising-v0": "ppo.toml",
+    "OrbitRaisingUncertain-v0": "ppo_uncertain.toml",
+    "OrbitRaisingContinuous-v0": "ppo_continuous.toml",
+}
+#: Satellites stepped together in a trial with SB3's defaults.
+SWEEP_NUM_ENVS = 16
+#: Bootstrap resamples of the confidence intervals.
+BOOTSTRAP_SAMPLES = 2000
+
+
+def iqm(values: NDArray[np.float64]) -> float:
+    """Interquartile mean: the mean of the middle half (rliable's IQM; the mean for fewer than 4 values)."""
+    x = np.sort(np.asarray(values, dtype=np.float64))
+    n = x.size
+    if n < 4:
+        return float(x.mean())
+    cut = n // 4
+    return float(x[cut : n - cut].mean())
+
+
+def bootstrap_interval(values: NDArray[np.float64], seed: int = 0, level: float = 0.95) -> tuple[float, float]:
+    """A ``level`` bootstrap confidence interval of the IQM, the runs resampled with replacement."""
+    x = np.asarray(values, dtype=np.float64)
+    rng = np.random.default_rng(seed)
+    draws = np.array([iqm(x[rng.integers(0, x.size, x.size)]) for _ in range(BOOTSTRAP_SAMPLES)])
+    tail = (1.0 - level) / 2.0
+    return float(np.quantile(draws, tail)), float(np.quantile(draws, 1.0 - tail))
+
+
+def table(trials: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per algorithm: IQM of the capture with its 95% interval, the optimality gap, the returns."""
+    rows = []
+    for algo in dict.fromkeys(t["algo"] for t in trials):
+        mine = [t for t in trials if t["algo"] == algo]
+        returns = np.array([t["mean_return"] for t in mine])
+        row: dict[str, Any] = {
+            "algo": algo,
+            "seeds": len(mine),
+            "mean_return": float(returns.mean()),
+            "iqm_return": iqm(returns),
+            "wall_s": float(sum(t["wall_s"] for t in mine)),
+        }
+        captures = [t["capture"] for t in mine]
+        if all(c is not None for c in captures):
+            c = np.array(captures)
+            low, high = bootstrap_interval(c)
+            row.update({"iqm_capture": iqm(c), "capture_ci95": [low, high], "optimality_gap": float(1.0 - c.mean())})
+        rows.append(row)
+    return rows
+
+
+def format_table(env_id: str, rows: list[dict[str, Any]], timesteps: int) -> str:
+    """The table for people."""
+    lines = [
+        f"{env_id}: {timesteps} timesteps per trial; capture = (R - R_never) / (R_dp - R_never)",
+        f"{'algo':<11} {'seeds':>5} {'IQM capture':>12} {'95% CI':>17} {'gap':>7} {'mean return':>12} {'wall [s]':>9}",
+    ]
+    for r in rows:
+        if "iqm_capture" in r:
+            ci = f"[{r['capture_ci95'][0]:6.1%}, {r['capture_ci95'][1]:6.1%}]"
+            capture, gap = f"{r['iqm_capture']:12.1%}", f"{r['optimality_gap']:7.1%}"
+        else:
+            ci, capture, gap = "", "", ""
+        lines.append(
+            f"{r['algo']:<11} {r['seeds']:>5} {capture:>12} {ci:>17} {gap:>7} {r['mean_return']:12.2f} "
+            f"{r['wall_s']:9.0f}"
+        )
+    return "\n".join(lines)
+
+
+def train_trial(
+    env_id: str, algo: str, seed: int, timesteps: int, out_dir: str | Path, num_envs: int = SWEEP_NUM_ENVS
+) -> Path:
+    """Train one algorithm with one seed; return where its model went."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if algo == "ppo_recipe":
+        from orbit_env.agents.train import train
+
+        config = resources.files("orbit_env.agents").joinpath(RECIPES[env_id])
+        result = train(config, out, total_timesteps=timesteps, seed=seed, progress=False, force=True)
+        return result.model_path
+    import stable_baselines3
+    import torch
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from orbit_env.envs.sb3 import make_sb3_vec_env
+
+    torch.set_num_threads(1)
+    venv = VecMonitor(make_sb3_vec_env(env_id, num_envs=num_envs, seed=seed))
+    model = getattr(stable_baselines3, algo.upper())("MlpPolicy", venv, seed=seed, device="cpu", verbose=0)
+    model.learn(total_timesteps=timesteps)
+    model.orbit_env = {"env_id": env_id, "env": {}}
+    path = out / "model.zip"
+    model.save(path, exclude=["env", "tensorboard_log"])
+    return path
+
+
+def run_trial(config: dict[str, Any]) -> dict[str, Any]:
+    """One trial (Ray Tune's function trainable): train, then score on the evaluation episodes."""
+    from orbit_env.agents.evaluate import load_model, run_episodes
+
+    start = time.perf_counter()
+    trial_dir = Path(config["out"]) / "trials" / f"{config['algo']}_seed{config['seed']}"
+    path = train_trial(config["env_id"], config["algo"], int(config["seed"]), int(config["timesteps"]), trial_dir)
+    _, model = load_model(config["env_id"], path)
+    returns = run_episodes(config["env_id"], model, int(config["episodes"]), int(config["eval_seed"])).returns
+    mean = float(returns.mean())
+    never, dp = config.get("never_return"), config.get("dp_return")
+    capture = None if never is None or dp is None or abs(dp - never) < 1e-9 else (mean - never) / (dp - never)
+    return {
+        "algo": config["algo"],
+        "seed": int(config["seed"]),
+        "mean_return": mean,
+        "capture": capture,
+        "wall_s": time.perf_counter() - start,
+        "model": str(path),
+    }
+
+
+def _ray_trainable(config: dict[str, Any]) -> None:
+    from ray import tune
+
+    tune.report(run_trial(config))
+
+
+def sweep(
+    env_id: str,
+    algos: list[str],
+    seeds: int,
+    timesteps: int,
+    out_dir: str | Path,
+    *,
+    address: str | None = None,
+    episodes: int = 1000,
+    eval_seed: int | None = None,
+    include_dp: bool = True,
+    cpus_per_trial: float = 1.0,
+    progress: Any = None,
+) -> dict[str, Any]:
+    """Run the trials on Ray Tune, write ``out_dir/results.json``, return its content (see the module).
+
+    Raises:
+        ValueError: an unknown env or algorithm, one that does not fit the action space, counts below 1.
+        ImportError: Ray is not installed (the ``cluster`` extra).
+    """
+    from orbit_env.agents.evaluate import EVAL_SEED, check_env_id, dp_policy, hand_coded_policies, run_episodes
+
+    check_env_id(env_id)
+    from orbit_env.agents.evaluate import task_of
+
+    kind = "continuous" if task_of(env_id).continuous else "discrete"
+    for algo in algos:
+        if algo not in SWEEP_ALGOS:
+            raise ValueError(f"unknown algorithm {algo!r}; allowed: {', '.join(SWEEP_ALGOS)}")
+        if kind not in SWEEP_ALGOS[algo]:
+            raise ValueError(f"{algo} does not act in the {kind} action space of {env_id}")
+    if seeds < 1 or timesteps < 1 or episodes < 1:
+        raise ValueError("seeds, timesteps and episodes must be >= 1")
+    try:
+        import ray
+        from ray import tune
+    except ImportError as error:
+        raise ImportError("orbit-env sweep runs on Ray Tune: pip install 'orbit-env[cluster]'") from error
+    say = progress or (lambda text: None)
+    eval_seed = EVAL_SEED if eval_seed is None else eval_seed
+    out = Path(out_dir).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    # The references of the capture, once for all trials (the DP's solve is the heavy part).
+    references_path = out / "references.json"
+    if references_path.is_file():
+        references = json.loads(references_path.read_text())
+    else:
+        say("references: never" + (" and dp" if include_dp else ""))
+        never = run_episodes(env_id, hand_coded_policies(env_id)["never"], episodes, eval_seed).returns.mean()
+        references = {"never_return": float(never), "dp_return": None}
+        if include_dp:
+            references["dp_return"] = float(run_episodes(env_id, dp_policy(env_id), episodes, eval_seed).returns.mean())
+        references_path.write_text(json.dumps(references) + "\n")
+    param_space = {
+        "env_id": env_id,
+        "algo": tune.grid_search(list(algos)),
+        "seed": tune.grid_search(list(range(seeds))),
+        "timesteps": int(timesteps),
+        "episodes": int(episodes),
+        "eval_seed": int(eval_seed),
+        "out": str(out),
+        **references,
+    }
+    start = time.perf_counter()
+    ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
+    try:
+        trainable = tune.with_resources(_ray_trainable, {"cpu": cpus_per_trial})
+        storage = out / "ray"
+        if tune.Tuner.can_restore(str(storage / "sweep")):
+            say("resuming the sweep in " + str(storage / "sweep"))
+            tuner = tune.Tuner.restore(str(storage / "sweep"), trainable, resume_errored=True)
+        else:
+            tuner = tune.Tuner(
+                trainable,
+                param_space=param_space,
+                run_config=tune.RunConfig(name="sweep", storage_path=str(storage), verbose=0),
+            )
+        grid = tuner.fit()
+        cores = int(ray.cluster_resources().get("CPU", 0))
+    finally:
+        ray.shutdown()
+    trials = []
+    for result in grid:
+        if result.error is not None or not result.metrics or "mean_return" not in result.metrics:
+            raise RuntimeError(f"a trial failed: {result.error}")
+        trials.append({key: result.metrics[key] for key in ("algo", "seed", "mean_return", "capture", "wall_s")})
+    trials.sort(key=lambda t: (list(algos).index(t["algo"]), t["seed"]))
+    output = {
+        "env": env_id,
+        "timesteps": int(timesteps),
+        "episodes": int(episodes),
+        "eval_seed": int(eval_seed),
+        **references,
+        "trials": trials,
+        "table": table(trials),
+        "sweep_wall_s": time.perf_counter() - start,
+        "cores": cores,
+    }
+    (out / "results.json").write_text(json.dumps(output, indent=1) + "\n")
+    return output

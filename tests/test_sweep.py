@@ -1,0 +1,65 @@
+"""``orbit-env sweep``: the table's statistics, and a two-trial sweep on a local Ray (slow)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from orbit_env.agents.sweep import bootstrap_interval, iqm, table
+
+
+def test_iqm_is_the_mean_of_the_middle_half():
+    assert iqm(np.array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 100.0])) == pytest.approx(3.5)  # 2, 3, 4, 5
+    assert iqm(np.array([1.0, 2.0, 3.0])) == pytest.approx(2.0)  # fewer than 4: the mean
+    assert iqm(np.array([0.9, 0.1, 0.95, 0.92, 0.93])) == pytest.approx(np.mean([0.92, 0.93, 0.9]))
+
+
+def test_bootstrap_interval_brackets_the_iqm_and_shrinks_with_agreement():
+    rng = np.random.default_rng(0)
+    spread = rng.normal(0.8, 0.1, 10)
+    low, high = bootstrap_interval(spread)
+    assert low < iqm(spread) < high
+    tight_low, tight_high = bootstrap_interval(0.8 + 0.01 * (spread - 0.8))
+    assert tight_high - tight_low < 0.2 * (high - low)
+
+
+def test_table_rows_per_algorithm():
+    trials = [
+        {"algo": "ppo", "seed": s, "mean_return": 250.0 + s, "capture": 0.5 + 0.1 * s, "wall_s": 1.0} for s in range(5)
+    ] + [{"algo": "a2c", "seed": 0, "mean_return": 230.0, "capture": None, "wall_s": 2.0}]
+    rows = table(trials)
+    assert [r["algo"] for r in rows] == ["ppo", "a2c"]
+    assert rows[0]["iqm_capture"] == pytest.approx(0.7) and rows[0]["optimality_gap"] == pytest.approx(0.3)
+    assert rows[0]["capture_ci95"][0] <= 0.7 <= rows[0]["capture_ci95"][1]
+    assert "iqm_capture" not in rows[1] and rows[1]["mean_return"] == 230.0
+
+
+@pytest.mark.slow
+def test_a_two_trial_sweep_on_a_local_ray_writes_and_resumes(tmp_path, capsys):
+    pytest.importorskip("ray", reason="needs orbit-env[cluster]")
+    from orbit_env.cli import main
+
+    argv = ["sweep", "--env", "OrbitRaising-v0", "--algos", "a2c", "--seeds", "2", "--timesteps", "160"]
+    argv += ["--episodes", "8", "--no-dp", "--out", str(tmp_path / "sweep")]
+    assert main(argv) == 0
+    results = json.loads((tmp_path / "sweep" / "results.json").read_text())
+    assert [(t["algo"], t["seed"]) for t in results["trials"]] == [("a2c", 0), ("a2c", 1)]
+    for trial in results["trials"]:
+        assert set(trial) == {"algo", "seed", "mean_return", "capture", "wall_s"}
+        assert np.isfinite(trial["mean_return"]) and trial["wall_s"] > 0 and trial["capture"] is None
+    assert results["table"][0]["seeds"] == 2 and results["cores"] >= 1
+    assert (tmp_path / "sweep" / "trials" / "a2c_seed1" / "model.zip").is_file()
+    # Run again: the finished trials are restored, not trained again.
+    stamp = (tmp_path / "sweep" / "trials" / "a2c_seed1" / "model.zip").stat().st_mtime_ns
+    assert main(argv) == 0
+    assert "resuming the sweep" in capsys.readouterr().err
+    assert (tmp_path / "sweep" / "trials" / "a2c_seed1" / "model.zip").stat().st_mtime_ns == stamp
+
+
+def test_sweep_refuses_an_algorithm_that_does_not_fit(tmp_path):
+    from orbit_env.agents.sweep import sweep
+
+    with pytest.raises(ValueError, match="dqn does not act in the continuous action space"):
+        sweep("OrbitRaisingContinuous-v0", ["dqn"], 1, 10, tmp_path)
+    with pytest.raises(ValueError, match="unknown algorithm 'ppo2'"):
+        sweep("OrbitRaising-v0", ["ppo2"], 1, 10, tmp_path)
