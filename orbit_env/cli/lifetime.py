@@ -237,12 +237,15 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             new_perigee_km=float(rule.new_perigee_m[0]) / 1e3 - offset,
             dv_m_s=float(rule.dv_m_s[0]),
         )
+    band = None
+    if args.uncertainty:
+        band = orbit_inputs.uncertainty(args, orbit, scenario, satellite, result, summary)
     if args.trajectory:
         write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset, result.epoch_days))
     if args.plot:
         from orbit_env.analysis.plots import plot_history
 
-        plot_history(result, args.plot, activity=scenario.activity, height_offset_km=offset)
+        plot_history(result, args.plot, activity=scenario.activity, height_offset_km=offset, band_days=band)
     if args.json:
         summary["atmosphere"] = _atmosphere(args, scenario)
         print(_json(summary))
@@ -260,6 +263,9 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             print(f"re-entry           {summary['reentry_date']}")
     else:
         print(f"lifetime           still in orbit after {result.days / 365.25:.0f} years (where the propagation stops)")
+    if args.uncertainty:
+        for line in orbit_inputs.uncertainty_lines(summary):
+            print(line)
     print(f"perigee velocity   {result.perigee_velocity_m_s:.1f} m/s")
     print(f"method             {result.method}")
     if rule is not None:
@@ -420,6 +426,7 @@ def add_parsers(sub: Any) -> None:
     life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
     life.add_argument("--force", action="store_true", help="with --batch: replace an existing --out file")
     life.add_argument("--no-progress", action="store_true", help="with --batch: no progress bar")
+    orbit_inputs.add_uncertainty_options(life)
     life.add_argument("--json", action="store_true", help="print one JSON object")
     life.add_argument("--trajectory", metavar="CSV", help="write the decay history to a CSV file")
     life.add_argument("--plot", metavar="PNG", help="plot the decay history")

@@ -350,3 +350,61 @@ def records_in_reference(records: list[dict[str, Any]], reference: str) -> list[
             if record.get(key, "") != "":
                 record[key] = f"{float(record[key]) - shift:.6g}"
     return records
+
+
+def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
+    """``--uncertainty``, ``--samples``, ``--seed``."""
+    from orbit_env.cli.common import positive_int
+
+    group = parser.add_argument_group("uncertainty (orbit_env.analysis.uncertainty)")
+    group.add_argument(
+        "--uncertainty",
+        action="store_true",
+        help="Monte Carlo over the solar forecast, NRLMSIS's error and the drag coefficient: percentiles, "
+        "and with --rule the probability of compliance",
+    )
+    group.add_argument("--samples", type=positive_int, default=1000, help="with --uncertainty: samples (default 1000)")
+    group.add_argument("--seed", type=int, default=0, help="with --uncertainty: random seed (default 0)")
+
+
+def uncertainty(
+    args: argparse.Namespace, orbit: OrbitInput, scenario: Any, satellite: Satellite, result: Any, summary: dict
+) -> tuple[float, float] | None:
+    """Run ``--uncertainty``; add its keys to ``summary``; return the 5-95% band [days] for the plot."""
+    from orbit_env.analysis.uncertainty import lifetime_spread, spread_report
+
+    perigee_km, apogee_km = orbit.sphere_heights_km
+    spread = lifetime_spread(
+        perigee_km * 1e3,
+        apogee_km * 1e3,
+        satellite.drag_parameter_m2_kg,
+        sphere_scenario(scenario, orbit.reference, args.inclination),
+        args.inclination,
+        samples=args.samples,
+        seed=args.seed,
+    )
+    epoch = result.epoch_days
+    if epoch is None and orbit.elements is not None:
+        epoch = orbit.elements.epoch_days
+    summary.update(spread_report(spread, epoch, args.rule))
+    low, high = summary["days_percentiles"]["5"], summary["days_percentiles"]["95"]
+    return None if low is None or high is None else (low, high)
+
+
+def uncertainty_lines(summary: dict[str, Any]) -> list[str]:
+    """The text output's lines of ``--uncertainty``."""
+    days = summary["days_percentiles"]
+
+    def years(value: float | None) -> str:
+        return "beyond the propagation" if value is None else f"{value / 365.25:.2f}"
+
+    lines = [
+        f"lifetime 5/50/95%  {years(days['5'])} / {years(days['50'])} / {years(days['95'])} years "
+        f"({summary['uncertainty_samples']} samples, seed {summary['uncertainty_seed']})"
+    ]
+    dates = summary.get("reentry_date_percentiles")
+    if dates:
+        lines.append(f"re-entry 5-95%     {dates['5'] or '-'} to {dates['95'] or '-'}")
+    if "rule_verdict" in summary:
+        lines.append(f"rule, 90% conf.    {summary['rule_verdict']}")
+    return lines

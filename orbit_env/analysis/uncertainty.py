@@ -1,0 +1,221 @@
+"""Lifetime with its uncertainty: Monte Carlo over the solar forecast, the density model and the drag coefficient.
+
+Units: SI inside (m, days); the public function takes heights in m above the package's
+6371 km sphere, as :meth:`orbit_env.analysis.scenario.Scenario.lifetime_days` does.
+
+Three sources, independent, each a log-normal factor (sigma in the natural log):
+
+* **the solar forecast** (:data:`SOLAR_FORECAST_SIGMA`): F10.7 and its 81-day mean after
+  the last observed day are multiplied by exp(sigma z). The record's monthly forecast
+  (NOAA SWPC's predicted cycle, as CelesTrak carries it) states no spread in the file; 0.15
+  is our reading of the spread of published cycle predictions (the NASA/NOAA Solar Cycle
+  25 Prediction Panel's and NASA MSFC's bands are about +-25-30% of the smoothed F10.7 at
+  95%; figures from memory, not checked against a source here). Observed days are not
+  varied. Without an epoch (a constant, user-given activity) this source is left out;
+* **the density model** (:data:`DENSITY_MODEL_SIGMA`): NRLMSIS's own error, a factor on
+  the density held for the whole life. Emmert et al. (2021, Earth and Space Science,
+  "NRLMSIS 2.0: A whole-atmosphere empirical model of temperature and neutral species
+  densities") compare the model with satellite-drag densities; 0.15 is our reading of the
+  10-20% standard deviations of such comparisons (from memory, not checked here);
+* **the drag coefficient** (:data:`DRAG_COEFFICIENT_SIGMA`): 0.10, for the accommodation
+  and attitude a free-molecular coefficient assumes, or the fit error of a B*.
+
+Everything goes through the fast paths: a fixed profile's lifetime is inversely
+proportional to the density scale and the drag coefficient (Eq. 3.4: the decay rate is
+linear in rho c), so the samples of a fixed profile are one lifetime divided by their
+factors, exactly. With an epoch, the time-stepped decay (:mod:`orbit_env.decay.chunked`)
+runs once per solar node (:data:`SOLAR_NODES`, values of z) with all samples at once, a
+vector of satellites each with its own density and drag factor; each sample's lifetime
+is then interpolated in z between the two nodes around it (linearly in log days). The
+interpolation error is measured in ``tests/test_uncertainty.py`` against samples
+propagated one by one. (A grid in the factor as well is cheaper but misses by up to 4%:
+the lifetime is not smooth in the factor where the fall meets a turn of the solar cycle.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.checks import check_int, check_number
+
+FloatArray = NDArray[np.float64]
+
+#: Log-normal sigma of F10.7 after the last observed day (see the module docstring).
+SOLAR_FORECAST_SIGMA = 0.15
+#: Log-normal sigma of NRLMSIS's density (see the module docstring).
+DENSITY_MODEL_SIGMA = 0.15
+#: Log-normal sigma of the drag coefficient.
+DRAG_COEFFICIENT_SIGMA = 0.10
+#: Values of the solar z at which the time-stepped decay runs; samples outside are extrapolated linearly.
+SOLAR_NODES = (-2.0, -1.0, 0.0, 1.0, 2.0)
+#: Percentiles reported.
+PERCENTILES = (5, 50, 95)
+#: The confidence STELA asks of the disposal rule ("within 25 years with probability >= 0.9").
+RULE_CONFIDENCE = 0.9
+
+
+@dataclass(frozen=True, eq=False)
+class ScaledForecast:
+    """An activity whose F10.7 and 81-day mean after ``after_days`` are multiplied by ``factor``.
+
+    Attributes:
+        activity: The activity it scales.
+        factor: Multiplier on F10.7 and its 81-day mean.
+        after_days: Unix days after which it applies (the last observed day).
+    """
+
+    activity: Any
+    factor: float
+    after_days: float
+
+    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The scaled indices (F10.7 kept inside NRLMSIS's range)."""
+        from orbit_env.physics.atmosphere.msis import F107_RANGE_SFU
+
+        f107, f107a, ap = self.activity.indices(days)
+        future = np.asarray(days, dtype=np.float64) > self.after_days
+        k = np.where(future, self.factor, 1.0)
+        low, high = F107_RANGE_SFU
+        return np.clip(f107 * k, low, high), np.clip(f107a * k, low, high), ap
+
+    def describe(self) -> str:
+        """One line."""
+        inner = self.activity.describe() if hasattr(self.activity, "describe") else type(self.activity).__name__
+        return f"{inner}, forecast x {self.factor:.3g}"
+
+
+@dataclass(frozen=True)
+class LifetimeSpread:
+    """Lifetimes of the Monte Carlo samples.
+
+    Attributes:
+        days: Each sample's lifetime [days] (the propagation's cap where it did not re-enter).
+        reentered: Per sample, whether it re-entered.
+        seed: The seed the samples came from.
+        sources: Which sources were sampled, with their sigmas.
+    """
+
+    days: FloatArray
+    reentered: NDArray[np.bool_]
+    seed: int
+    sources: dict[str, float]
+
+    def percentiles_days(self) -> dict[str, float | None]:
+        """The 5th, 50th and 95th percentile lifetimes [days] (None where beyond the propagation)."""
+        out: dict[str, float | None] = {}
+        for p in PERCENTILES:
+            value = float(np.percentile(np.where(self.reentered, self.days, np.inf), p))
+            out[str(p)] = value if math.isfinite(value) else None
+        return out
+
+    def compliance_probability(self, rule_years: float) -> float:
+        """Fraction of the samples that re-enter within ``rule_years``."""
+        years = check_number(rule_years, "rule_years", unit="years", low=0.0, low_inclusive=False)
+        return float(np.mean(self.reentered & (self.days <= years * 365.25)))
+
+
+def sample_factors(samples: int, seed: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The samples' solar z, density factor and drag-coefficient factor (seeded; the same twice)."""
+    n = check_int(samples, "samples", low=10, high=1_000_000)
+    rng = np.random.default_rng(check_int(seed, "seed", low=0))
+    z_sun = rng.standard_normal(n)
+    density = np.exp(DENSITY_MODEL_SIGMA * rng.standard_normal(n))
+    drag = np.exp(DRAG_COEFFICIENT_SIGMA * rng.standard_normal(n))
+    return z_sun, density, drag
+
+
+def lifetime_spread(
+    perigee_m: float,
+    apogee_m: float,
+    drag_parameter_m2_kg: float,
+    scenario: Any,
+    inclination_deg: float,
+    *,
+    samples: int = 1000,
+    seed: int = 0,
+) -> LifetimeSpread:
+    """Monte Carlo lifetimes of one satellite (see the module docstring).
+
+    Args:
+        perigee_m: Perigee height above the 6371 km sphere.
+        apogee_m: Apogee height above the sphere.
+        drag_parameter_m2_kg: c = c_x A / m.
+        scenario: The :class:`~orbit_env.analysis.scenario.Scenario`.
+        inclination_deg: The orbit's inclination.
+        samples: Number of samples.
+        seed: Seed of the random numbers.
+    """
+    z_sun, density, drag = sample_factors(samples, seed)
+    scale = density * drag
+    sources = {"density_model": DENSITY_MODEL_SIGMA, "drag_coefficient": DRAG_COEFFICIENT_SIGMA}
+    hp = np.full(z_sun.size, float(perigee_m))
+    ha = np.full(z_sun.size, float(apogee_m))
+    if not scenario.time_varying:
+        days, reentered = scenario.lifetime_days(perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
+        return LifetimeSpread(float(days) / scale, np.full(scale.size, bool(reentered)), seed, sources)
+    sources["solar_forecast"] = SOLAR_FORECAST_SIGMA
+    from orbit_env.decay.chunked import propagate
+
+    activity = scenario.solar
+    after = getattr(activity, "observed_end_days", -math.inf)
+    base = scenario.solar_model(inclination_deg)
+    # All samples at once at each solar node (a vector of satellites, each with its own density and drag
+    # factor); each sample's lifetime is then interpolated in z between the nodes, in log days.
+    nodes = np.array(SOLAR_NODES)
+    hp = np.full(z_sun.size, float(perigee_m))
+    ha = np.full(z_sun.size, float(apogee_m))
+    node_days, node_up = [], []
+    for z in SOLAR_NODES:
+        model = replace(base, activity=ScaledForecast(activity, math.exp(SOLAR_FORECAST_SIGMA * z), after))
+        result = propagate(hp, ha, drag_parameter_m2_kg, model, density_scale=scale * scenario.density_scale)
+        node_days.append(result.days)
+        node_up.append(result.reentered)
+    log_days = np.log(np.maximum(np.array(node_days), 1e-6))
+    right = np.clip(np.searchsorted(nodes, z_sun), 1, nodes.size - 1)
+    left = right - 1
+    w = (z_sun - nodes[left]) / (nodes[right] - nodes[left])
+    cols = np.arange(z_sun.size)
+    days = np.exp(log_days[left, cols] * (1.0 - w) + log_days[right, cols] * w)
+    up = np.array(node_up)
+    reentered = up[left, cols] & up[right, cols]
+    cap = base.max_years * 365.25
+    days = np.where(reentered, np.minimum(days, cap), cap)
+    return LifetimeSpread(days, reentered, seed, sources)
+
+
+def spread_report(spread: LifetimeSpread, epoch_days: float | None, rule_years: float | None) -> dict[str, Any]:
+    """The JSON keys of ``--uncertainty``: percentiles (days and dates), and the rule as a probability."""
+    from orbit_env.analysis.lifetime import iso_datetime
+
+    days = spread.percentiles_days()
+    report: dict[str, Any] = {
+        "days_percentiles": days,
+        "uncertainty_samples": int(spread.days.size),
+        "uncertainty_seed": spread.seed,
+        "uncertainty_sigmas": spread.sources,
+    }
+    if epoch_days is not None:
+        report["reentry_date_percentiles"] = {
+            key: None if value is None else iso_datetime(epoch_days + value) for key, value in days.items()
+        }
+    if rule_years is not None:
+        probability = spread.compliance_probability(rule_years)
+        report["compliance_probability"] = probability
+        report["complies_with_confidence"] = probability >= RULE_CONFIDENCE
+        report["rule_verdict"] = verdict(rule_years, probability)
+    return report
+
+
+def verdict(rule_years: float, probability: float) -> str:
+    """The rule at 90% confidence, in STELA's words ("re-enters within 25 years with probability >= 0.9")."""
+    holds = probability >= RULE_CONFIDENCE
+    sign = ">=" if holds else "<"
+    return (
+        f"{'complies' if holds else 'does not comply'}: re-enters within {rule_years:g} years with probability "
+        f"{probability:.3f} ({sign} {RULE_CONFIDENCE:g})"
+    )
