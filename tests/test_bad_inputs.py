@@ -244,6 +244,20 @@ def test_lifetimes_beyond_any_model_are_refused(capsys, argv, start):
     assert status == 2 and out == "" and err.startswith(f"orbit-env: error: {start}") and err.count("\n") == 1
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--density-scale", "200", "--rotating-atmosphere", "--method", "curves"],
+        ["--rho100", "1e-4", "--method", "curves"],
+    ],
+)
+def test_air_too_dense_for_the_curves_is_refused(capsys, argv):
+    # 200 and 61 times the paper's density at 100 km; the curves are built up to 20 times.
+    status, out, err = run(capsys, *ORBIT, *argv)
+    assert status == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith("orbit-env: error: the air at 100 km is ") and "built up to 20 times" in err
+
+
 def test_a_batch_row_beyond_any_model_gets_its_line(capsys, tmp_path):
     sats = tmp_path / "sats.csv"
     sats.write_text("perigee_km,apogee_km,mass_per_area_kg_m2\n\n1100,4000,90000\n300,400,50\n")

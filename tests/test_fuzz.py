@@ -356,8 +356,8 @@ def check_batch(tmp: Path, data: bytes, rows: int, lines: list[int], options: li
     ok = 0
     for record, line in zip(records, lines, strict=True):
         for key, value in record.items():
-            # Numbers are finite or empty; a status may quote the "nan" a user typed.
-            assert key == "status" or not NOT_FINITE.search(value), (argv, record)
+            # Numbers are finite or empty; a name or a status may quote the "nan" a user typed.
+            assert key in ("name", "status") or not NOT_FINITE.search(value), (argv, record)
         if record["status"] == "ok":
             ok += 1
             days = float(record["days"])

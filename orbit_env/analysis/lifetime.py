@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
-from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario
+from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density
 from orbit_env.checks import check_date, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
@@ -351,6 +351,7 @@ def lifetime(
         nu, days = revolutions / per_nu, direct.time_s / SECONDS_PER_DAY
     elif method == "curves":
         UniversalCurves.check_domain_km(perigee_km, apogee_km)
+        check_curves_density(atmosphere)
         curves = universal_curves(model)
         start = curves.locate(hp_m, ha_m)
         tau = np.linspace(float(start.tau), 0.0, 200)

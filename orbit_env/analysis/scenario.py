@@ -16,19 +16,41 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_number
-from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, cached_curves, propagate
 from orbit_env.decay.curves import UniversalCurves, universal_curves
 from orbit_env.decay.solar import ConstantActivity, CycleActivity, SolarActivity, TableActivity, iso_date
 from orbit_env.physics.atmosphere import Atmosphere, ExponentialAtmosphere, PaperAtmosphere
 from orbit_env.physics.atmosphere.exponential import ORBITAL_LAW
+from orbit_env.physics.atmosphere.paper import RHO100_CALIBRATED_KG_M3
 
 FloatArray = NDArray[np.float64]
 AtmosphereKind = Literal["paper", "exponential", "msis"]
 ATMOSPHERES: tuple[str, ...] = ("paper", "exponential", "msis")
 #: Bounds of a density scale factor, and why.
 DENSITY_SCALE_RANGE = (1e-3, 1e3, "the models are off by a factor of a few at most; 1000 is another atmosphere")
+
+
+#: Densest air at 100 km the universal curves are built for [kg/m^3]: 20 times the paper's
+#: calibrated law. The curves step through nu on a fixed grid, and in denser air the perigee moves
+#: too far per step near re-entry (at 30 times the family no longer closes, measured at 300 x 3000 km).
+CURVES_MAX_RHO100_KG_M3 = 20.0 * RHO100_CALIBRATED_KG_M3
+
+
+def check_curves_density(atmosphere: Atmosphere) -> None:
+    """Refuse, in the user's terms, an atmosphere too dense at 100 km for the universal curves.
+
+    Raises:
+        ValueError: its density at 100 km exceeds :data:`CURVES_MAX_RHO100_KG_M3`.
+    """
+    rho = float(np.asarray(atmosphere.density_kg_m3(REENTRY_ALTITUDE_M)))
+    if not rho <= CURVES_MAX_RHO100_KG_M3:
+        raise ValueError(
+            f"the air at 100 km is {rho:.3g} kg/m^3 with these options, {rho / RHO100_CALIBRATED_KG_M3:.3g} times "
+            f"the paper's; the universal curves are built up to 20 times (a lower --rho100 or --density-scale, "
+            "or --method averaged for a single orbit)"
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,8 +136,13 @@ class Scenario:
         return DecayModel(self.fixed_atmosphere(inclination_deg), self.rotating_atmosphere, inclination_deg)
 
     def curves(self, inclination_deg: float) -> UniversalCurves:
-        """The universal curves of the fixed profile (cached per profile)."""
+        """The universal curves of the fixed profile (cached per profile).
+
+        Raises:
+            ValueError: the profile is too dense at 100 km for the curves (:func:`check_curves_density`).
+        """
         model = self.decay_model(inclination_deg)
+        check_curves_density(model.atmosphere)
         if self.atmosphere == "msis":
             return cached_curves(model)  # the larger cache: batches may hold many inclinations
         return universal_curves(model)
