@@ -473,14 +473,17 @@ class UniversalCurves:
     def at(self, label: ArrayLike, tau: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Perigee height [m], apogee height [m] and mean period left [s] at (label, tau)."""
         if isinstance(label, float) and isinstance(tau, float):
-            mu_s = float(label)
-            b0, b1, b2 = self._table_b.values_scalar(mu_s, float(tau))
-            hp_s = max(b0, REENTRY_ALTITUDE_M)
-            e_s = math.exp(b1 + mu_s)
-            rp_s = EARTH_RADIUS_M + hp_s
-            return hp_s, rp_s * (1.0 + e_s) / (1.0 - e_s) - EARTH_RADIUS_M, b2
+            return self._at_scalar(float(label), float(tau))
         mu = np.asarray(label, dtype=np.float64)
         return _heights(mu, *self._table_b.values(mu, tau))
+
+    def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
+        """:meth:`at` for one orbit, in plain floats (the arithmetic of :func:`_heights`)."""
+        b0, b1, b2 = self._table_b.values_scalar(mu, tau)
+        hp = max(b0, REENTRY_ALTITUDE_M)
+        e = math.exp(b1 + mu)
+        rp = EARTH_RADIUS_M + hp
+        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, b2
 
     def _after(self, point: CurvePoint, dnu: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The (nu, tau) reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
@@ -506,6 +509,13 @@ class UniversalCurves:
         ``segments`` (from :meth:`locate_segments`, for these orbits' labels) the
         interpolation uses and updates them in place.
         """
+        if segments is None and isinstance(dnu, float) and isinstance(point.tau, float):
+            # One orbit (the single environment, every step): _after and at in plain floats.
+            nu_s = max(point.nu - dnu, 0.0)
+            tau_s = math.log1p(nu_s * (1.0 / NU_REF))
+            label_s = float(point.label)
+            hp_s, ha_s, q_s = self._at_scalar(label_s, tau_s)
+            return CurvePoint._with_nu(label_s, tau_s, q_s, nu_s), hp_s, ha_s
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
         if segments is None:

@@ -45,6 +45,7 @@ from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
     CurvePoint,
+    UniversalCurves,
     nu_per_revolution,
     universal_curves,
 )
@@ -140,6 +141,11 @@ class Task:
     def burn_sizes_m_s(self) -> FloatArray:
         """The discrete actions' burns [m/s]."""
         return np.array(self.config.burn_sizes_m_s, dtype=np.float64)
+
+    @cached_property
+    def curves(self) -> UniversalCurves:
+        """The universal curves the task steps on (the paper's atmosphere; the density scale multiplies g c)."""
+        return universal_curves()
 
     @cached_property
     def planning(self) -> Task:
@@ -785,7 +791,7 @@ def coast(task: Task, state: AnyState, steps: Any = 1.0) -> Any:
     """
     weighted_s = state.period_s * state.nu  # W = q nu, as CurvePoint.weighted_s (not cached: cheaper)
     revolutions = task.config.revolutions_per_step * steps
-    after, perigee_m, apogee_m = universal_curves().advance_heights(
+    after, perigee_m, apogee_m = task.curves.advance_heights(
         _point(state), revolutions * state.nu_per_rev, state.segments
     )
     days = (weighted_s - after.mean_period_s * after.nu) / (state.nu_per_rev * SECONDS_PER_DAY)
