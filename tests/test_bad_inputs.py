@@ -3,6 +3,7 @@
 import csv
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -317,6 +318,15 @@ def test_no_nan_in_the_trajectory_under_changing_activity(capsys, tmp_path):
     perigee, apogee = values[:, 2], values[:, 3]
     assert np.all(perigee <= apogee + 1e-9)
     assert np.all(np.diff(values[:, 1]) > 0)  # days increase
+
+
+def test_a_lifetime_under_a_day_is_not_printed_as_zero(capsys):
+    # A drag sail (1 kg/m^2) at 200 km comes down in minutes; "0.00 days" would read as no lifetime.
+    status, out, _ = run(capsys, "lifetime", "--perigee", "200", "--apogee", "200", "--mass-per-area", "1")
+    assert status == 0
+    line = next(line for line in out.splitlines() if line.startswith("lifetime"))
+    days, hours = re.match(r"lifetime\s+(\S+) days \((\S+) hours\)", line).groups()
+    assert 0.0 < float(days) < 1.0 and float(hours) == pytest.approx(24.0 * float(days), rel=0.01)
 
 
 def test_check_finite_refuses_nan_and_infinity():

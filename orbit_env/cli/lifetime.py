@@ -157,6 +157,13 @@ def _check_inclination(args: argparse.Namespace) -> None:
         check_number(args.inclination, "inclination_deg", unit="deg", low=0.0, high=180.0)
 
 
+def _days_text(days: float) -> str:
+    """A lifetime in days and years; under a day in three digits and hours, never "0.00 days"."""
+    if days >= 1.0 or days == 0.0:
+        return f"{days:.2f} days ({days / 365.25:.2f} years)"
+    return f"{days:.3g} days ({days * 24.0:.3g} hours)"
+
+
 def _json(summary: dict[str, Any]) -> str:
     """One JSON object; NaN and infinities are refused here rather than printed (they are not JSON)."""
     check_finite(summary, "the result")
@@ -258,7 +265,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")
     if result.reentered:
-        print(f"lifetime           {result.days:.2f} days ({result.days / 365.25:.2f} years)")
+        print(f"lifetime           {_days_text(result.days)}")
         if summary.get("reentry_date"):
             print(f"re-entry           {summary['reentry_date']}")
     else:
