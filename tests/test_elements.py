@@ -127,7 +127,9 @@ def test_cli_tle_json_reports_the_drag_parameter_and_its_source(capsys, tmp_path
         satellite=Satellite(1.0, 1.0, elements.drag_parameter_m2_kg),
         method="curves",  # the command line's default on the curves
     )
-    assert result["days"] == pytest.approx(api.days, rel=1e-12)
+    # Within the universal curves' own accuracy (0.5%, docs/validation.md): which table the curves come from
+    # (the disk cache, another test's in-memory family) moves the last digits; a wrong B* or height moves it by %.
+    assert result["days"] == pytest.approx(api.days, rel=2e-3)
     # stdin, and a satellite given on the command line wins over B*.
     import io
 
