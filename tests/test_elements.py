@@ -223,3 +223,27 @@ def test_shape_sphere_gets_the_free_molecular_coefficient(capsys):
     assert json.loads(out)["drag_parameter_m2_kg"] == pytest.approx(2.2 * math.pi * 0.15**2 / 20, rel=1e-12)
     status, _, err = run(capsys, *argv)
     assert status == 2 and err == "orbit-env: error: --shape sphere needs --diameter-m\n"
+
+
+def test_batch_of_element_sets(capsys, tmp_path):
+    import csv
+
+    path = tmp_path / "sets.tle"
+    path.write_text("\n".join([*CUBESAT, "ISS (ZARYA)", *ISS]) + "\n")
+    out = tmp_path / "out.csv"
+    status, _, _ = run(
+        capsys, "lifetime", "--batch", str(path), "--out", str(out), "--atmosphere", "paper", "--no-progress"
+    )
+    rows = list(csv.DictReader(out.open()))
+    assert [row["name"] for row in rows] == ["CUBESAT-550 (synthetic)", "ISS (ZARYA)"]
+    elements = parse_tle(*CUBESAT[1:])
+    # Heights above the equatorial radius, as the sets give them; c from B*; the inclination from the set.
+    assert float(rows[0]["perigee_km"]) == pytest.approx(elements.perigee_km, abs=1e-3)
+    assert float(rows[0]["drag_parameter_m2_kg"]) == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-5)
+    assert float(rows[0]["inclination_deg"]) == pytest.approx(97.5)
+    assert rows[0]["status"] == "ok" and float(rows[0]["days"]) > 0
+    # The ISS set's B* < 0: a status naming its line, and the batch goes on (exit 1: a row without a lifetime).
+    assert (
+        rows[1]["status"].startswith("line 5: B* = -1.1606e-05 /ER gives no drag parameter") and rows[1]["days"] == ""
+    )
+    assert status == 1

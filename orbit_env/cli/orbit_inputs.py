@@ -126,6 +126,7 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
     if args.atmosphere is None:
         args.atmosphere = "msis" if args.epoch is not None else "paper"
     reference = getattr(args, "height_reference", None)
+    args.height_reference_given = reference is not None
     if reference is None:
         reference = "equatorial" if elements is not None else default_height_reference(args.atmosphere)
     args.height_reference = reference
@@ -306,6 +307,8 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any)
 
     from orbit_env.analysis.elements import looks_like_tle, read_tle
 
+    if looks_like_tle(args.batch) and not getattr(args, "height_reference_given", False):
+        args.height_reference = "equatorial"  # element sets give heights above the equatorial radius
     offset_m = offset_km(args.height_reference) * 1e3
     if not looks_like_tle(args.batch):
         rows, hp, ha, c, inc, status = read_batch(
