@@ -63,3 +63,22 @@ def test_sweep_refuses_an_algorithm_that_does_not_fit(tmp_path):
         sweep("OrbitRaisingContinuous-v0", ["dqn"], 1, 10, tmp_path)
     with pytest.raises(ValueError, match="unknown algorithm 'ppo2'"):
         sweep("OrbitRaising-v0", ["ppo2"], 1, 10, tmp_path)
+
+
+def test_the_shipped_baseline_tables_are_complete():
+    from importlib import resources
+
+    folder = resources.files("orbit_env.agents").joinpath("baselines")
+    files = sorted(p.name for p in folder.iterdir() if p.name.endswith(".json"))
+    assert "OrbitRaising-v0.json" in files
+    for name in files:
+        results = json.loads(folder.joinpath(name).read_text())
+        assert results["env"] + ".json" == name
+        algos = {t["algo"] for t in results["trials"]}
+        assert {row["algo"] for row in results["table"]} == algos
+        for row in results["table"]:
+            assert row["seeds"] == 5
+            low, high = row["capture_ci95"]
+            assert low <= row["iqm_capture"] <= high
+        # The table is the statistics of the trials it ships with.
+        assert [r["iqm_capture"] for r in table(results["trials"])] == [r["iqm_capture"] for r in results["table"]]
