@@ -225,3 +225,9 @@ def test_the_shipped_continuous_ppo_captures_most_of_the_optimums_gain():
     greedy = run_episodes(env_id, base["greedy"], episodes=200, seed=777).returns.mean()
     ppo = run_episodes(env_id, load_model(env_id)[1], episodes=200, seed=777).returns.mean()
     assert ppo > greedy - 1.0 and ppo - never > 0.9 * (greedy - never)
+
+
+def test_evaluate_without_the_dp_prints_no_capture_footer(capsys):
+    assert main(["evaluate", "--episodes", "4", "--no-dp"]) == 0
+    out = capsys.readouterr().out
+    assert "ppo - greedy, paired" in out and "capture =" not in out
