@@ -86,3 +86,8 @@ def test_cli_reports_percentiles_dates_and_the_rule_as_a_probability(capsys):
     assert first["rule_verdict"].startswith(("complies: re-enters within 0.1 years", "does not comply"))
     status, out, _ = run(capsys, *argv, "--rule", "0.1", "--json")
     assert json.loads(out)["days_percentiles"] == first["days_percentiles"]  # seeded: the same twice
+
+
+def test_a_bad_seed_names_the_flag(capsys):
+    status, _, err = run(capsys, "lifetime", "--perigee", "300", "--apogee", "300", "--uncertainty", "--seed", "-1")
+    assert status == 2 and err == "orbit-env: error: --seed -1 is out of range; allowed: an integer at least 0\n"

@@ -105,6 +105,8 @@ FLAGS: dict[str, tuple[str, float, str | None]] = {
     "semi_major_axis_km": ("semi_major_axis_km", 1.0, None),
     "eccentricity": ("eccentricity", 1.0, None),
     "diameter_m": ("diameter_m", 1.0, None),
+    "samples": ("samples", 1.0, None),
+    "seed": ("seed", 1.0, None),
     "rule_years": ("rule", 1.0, None),
     "reentry_sigma_days": ("reentry_sigma_days", 1.0, None),
     "height_sigma_km": ("height_sigma_km", 1.0, None),
