@@ -9,7 +9,7 @@ The CLI's contract, checked on every case:
   exit 2 nothing on stdout and no results file written. (Batch exit 1: the results
   file is complete and some rows have no lifetime, as docs/how-to/catalogue.md says.)
 
-The default run tries 240 cases (lifetime 100, fit-density 70, batch 70) in about 20 s;
+The default run tries 240 cases (lifetime 100, fit-density 70, batch 70) in about 25 s (measured on 2 shared cores);
 ``-m slow`` runs 11 000 (5000, 3000, 3000) and the env fuzz (10^5 episodes). NRLMSIS is
 left out: each new inclination or activity builds a profile (seconds), too slow to fuzz.
 """
