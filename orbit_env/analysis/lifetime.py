@@ -15,8 +15,8 @@ from numpy.typing import NDArray
 
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
 from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density
-from orbit_env.checks import check_date, check_number
-from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.checks import InputError, check_date, check_number
+from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate, reference_path
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
@@ -456,8 +456,12 @@ def check_rule(
     The burn is a retrograde burn at apogee that lowers the perigee (the apogee stays).
 
     Lifetimes come from the universal curves of the scenario (time-stepped if it
-    has an epoch), see :mod:`orbit_env.analysis.disposal`. Heights must lie in the curves'
-    domain (perigee <= 1100 km, apogee <= 4000 km).
+    has an epoch), see :mod:`orbit_env.analysis.disposal`. Above the curves' domain
+    (perigee > 1100 km or apogee > 4000 km: a GTO, a Molniya orbit) a fixed atmosphere's
+    lifetimes come from the averaged equations instead (one integration per candidate
+    perigee, 49 in all; the same equations as ``lifetime(method="averaged")``, so the
+    printed lifetime and the verdict are one computation); a time-stepped scenario is
+    refused there.
 
     Example:
         >>> check = check_rule(800, 800, 25, satellite=Satellite(2.2, 100.0, 1.0))
@@ -466,8 +470,14 @@ def check_rule(
     """
     satellite = satellite or Satellite()
     scenario = scenario or Scenario()
-    hp_m, ha_m = UniversalCurves.check_domain_km(perigee_km, apogee_km)
+    hp_m, ha_m = validate_heights_km(perigee_km, apogee_km)
     c = satellite.drag_parameter_m2_kg
+    try:
+        UniversalCurves.check_domain_km(perigee_km, apogee_km)
+    except InputError:
+        if scenario.time_varying:
+            raise
+        return check_disposal_rule(hp_m, ha_m, rule_years, _averaged_lifetimes(scenario, c, inclination_deg))
 
     def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
         # Called once check_disposal_rule has checked rule_years.
@@ -475,3 +485,18 @@ def check_rule(
         return scenario.lifetime_days(hp, ha, np.full(hp.shape, c), inclination_deg, max_days=cap_days)
 
     return check_disposal_rule(hp_m, ha_m, rule_years, lifetimes)
+
+
+def _averaged_lifetimes(scenario: Scenario, c: float, inclination_deg: float) -> Any:
+    """The rule's lifetime function on the averaged equations (fixed profile; any heights)."""
+    model = scenario.decay_model(inclination_deg)
+    rate = G0_M_S2 * c * scenario.density_scale
+
+    def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
+        days = np.zeros(hp.size)
+        for i, (perigee, apogee) in enumerate(zip(hp.tolist(), ha.tolist(), strict=True)):
+            if perigee > REENTRY_ALTITUDE_M:
+                days[i] = float(integrate_averaged(perigee, apogee, model).weighted_s[-1]) / rate / SECONDS_PER_DAY
+        return days, np.ones(hp.size, dtype=bool)
+
+    return lifetimes
