@@ -1,6 +1,6 @@
 """How far below the true optimum is the DP? A search for plans that beat it (``orbit-env evaluate --certify``).
 
-The DP (:mod:`orbit_env.agents.dp`) is the yardstick of every capture, but it is solved
+The DP (`orbit_env.agents.dp`) is the yardstick of every capture, but it is solved
 on a grid, so its policy can be beaten. This check searches, start by start, for an
 action sequence that earns more than the DP policy in the environment itself, and
 reports the gap it finds: a lower bound on the DP policy's distance to the optimum
@@ -10,11 +10,11 @@ For each of ``episodes`` seeded start orbits (those of ``orbit-env evaluate``):
 
 1. the DP policy plays the episode; its return is the reference and its actions the
    first plan;
-2. every open-loop plan of burns on the first :data:`EARLY_STEPS` steps (all
-   combinations of :data:`EARLY_BURNS`), then coasting;
+2. every open-loop plan of burns on the first `EARLY_STEPS` steps (all
+   combinations of `EARLY_BURNS`), then coasting;
 3. hill climbing from the best plan so far: ``rounds`` rounds of ``perturbations``
-   random changes each (move a burn by up to :data:`MAX_SHIFT` steps, resize it, split
-   it over two steps, add one in the first :data:`ADD_WINDOW` steps, or drop one),
+   random changes each (move a burn by up to `MAX_SHIFT` steps, resize it, split
+   it over two steps, add one in the first `ADD_WINDOW` steps, or drop one),
    keeping a change that earns more.
 
 Every plan is scored in ``gymnasium.make_vec`` of the environment (the task model, no
@@ -39,7 +39,7 @@ from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_pol
 
 FloatArray = NDArray[np.float64]
 
-#: Steps at the start over which every combination of :data:`EARLY_BURNS` is tried.
+#: Steps at the start over which every combination of `EARLY_BURNS` is tried.
 EARLY_STEPS = 3
 #: Burns tried in those steps [m/s] (the discrete variants use their own burn sizes).
 EARLY_BURNS = (0.0, 10.0, 20.0, 30.0, 50.0, 100.0)
@@ -152,7 +152,7 @@ class _Plans:
 
 
 def _early_plans(plans: _Plans) -> FloatArray:
-    """Every combination of early burns on the first :data:`EARLY_STEPS` steps, then coasting: (m, horizon)."""
+    """Every combination of early burns on the first `EARLY_STEPS` steps, then coasting: (m, horizon)."""
     burns = plans.sizes if not plans.continuous else np.asarray(EARLY_BURNS)
     grids = np.meshgrid(*([burns] * EARLY_STEPS), indexing="ij")
     early = np.stack([g.ravel() for g in grids], axis=1)
@@ -219,7 +219,7 @@ def certify(
         rounds: Rounds of hill climbing.
         perturbations: Random changes tried per start and round.
         policy: The policy to certify (default: the env's DP policy).
-        dp_lookahead: The DP policy's ``lookahead`` (:class:`orbit_env.agents.dp.DPPolicy`).
+        dp_lookahead: The DP policy's ``lookahead`` (`orbit_env.agents.dp.DPPolicy`).
         progress: Called with a line of text as the search goes.
 
     Raises:

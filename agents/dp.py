@@ -22,7 +22,7 @@ mass and the steps left. The grid uses three coordinates of it:
   mu = -9.07), the spacing grows geometrically up to the most elongated
   reachable orbit. Below ``MU_LOW``
   (e < 1e-7 at re-entry) the orbits are circular to within metres and carry the
-  same lifetime (see :mod:`orbit_env.decay.curves`): the value is clamped.
+  same lifetime (see `orbit_env.decay.curves`): the value is clamped.
 * n = nu / (K g c s), the lifetime left in steps at the current mass: a coast of
   one step moves it from n to n - 1 exactly, so with ``life_per_step`` levels per
   unit of n up to the horizon + 1 (and a geometric tail above, where every orbit
@@ -58,8 +58,8 @@ days where the successor outlives the mission.
 
 Grid refinement on the 200 evaluation episodes of ``orbit-env evaluate``
 (seed 12345; default config, density scale 1): "value" is the mean of
-:meth:`DPSolution.value` at the start states, "realized" the mean return of
-:class:`DPPolicy` in the env, |d| = |value - realized| per episode, "greedy
+`DPSolution.value` at the start states, "realized" the mean return of
+`DPPolicy` in the env, |d| = |value - realized| per episode, "greedy
 ahead" the worst episode's lead of the greedy look-ahead over the DP policy.
 Solve times on one core of a 2-core machine with a PPO training on the other;
 "memory" is the solving process' peak.
@@ -425,7 +425,7 @@ class DPSolution:
         """The optimum's expected return from a state [days] (arrays broadcast).
 
         The one-step look-ahead of the policy, max_a r_a + V_{k-1}(successor), so
-        it is what :class:`DPPolicy` expects to earn from there.
+        it is what `DPPolicy` expects to earn from there.
 
         Raises:
             ValueError: heights outside the curves, negative delta-v, or steps
@@ -643,7 +643,7 @@ class DPPolicy:
 
     Args:
         config: The env's config (default: ``OrbitRaisingConfig()``).
-        grid: The DP grid (see :func:`solve`).
+        grid: The DP grid (see `solve`).
         density_scale: The density scale the planner knows.
         solution: A solution to act on, instead of solving (its config wins).
         lookahead: Decisions taken exactly before the grid's values are read: 1 (the

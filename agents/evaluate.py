@@ -55,7 +55,7 @@ class Episodes:
     dv_m_s: FloatArray
 
     def summary(self) -> dict[str, float]:
-        """Mean and spread, with the public JSON keys (``capture`` is added by :func:`summarize`)."""
+        """Mean and spread, with the public JSON keys (``capture`` is added by `summarize`)."""
         return {
             "mean_return": float(self.returns.mean()),
             "std_return": float(self.returns.std()),
@@ -81,7 +81,7 @@ def run_episodes(
     """Play one episode per sub-environment of a seeded vector env with ``policy``.
 
     ``env_kwargs``: the environment's keywords (``horizon_steps=...``, see
-    :class:`orbit_env.envs.OrbitRaisingEnv`).
+    `orbit_env.envs.OrbitRaisingEnv`).
     """
     check_env_id(env_id)
     if episodes < 1:
@@ -184,7 +184,7 @@ def format_table(
     table: Mapping[str, Mapping[str, float | None]],
     paired: Sequence[Mapping[str, Any]] = (),
 ) -> str:
-    """The evaluation as a text table for people (``paired``: results of :func:`paired_difference`)."""
+    """The evaluation as a text table for people (``paired``: results of `paired_difference`)."""
     lines = [
         f"{env_id}: {episodes} episodes (seed {seed})",
         f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
@@ -332,10 +332,10 @@ def all_policies(
     warn: Callable[[str], None] | None = None,
     dp_lookahead: int = 1,
 ) -> dict[str, Predictor]:
-    """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in :data:`POLICY_ORDER`.
+    """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in `POLICY_ORDER`.
 
     The learned agent (``model_path``, or the shipped one) is loaded and checked
-    first (:func:`load_model`), before the DP's solve; its row is named by its
+    first (`load_model`), before the DP's solve; its row is named by its
     algorithm (``ppo``, ``a2c``, ...).
     """
     learned = load_model(env_id, model_path, warn)
@@ -375,7 +375,7 @@ class OracleDP:
     (log spacing, ``rungs`` over the scale range). It plans as if that scale then
     stayed constant, so with the slow solar-cycle drift it is a near-optimal
     reference, not an exact bound. Each rung's DP is solved on ``grid`` (default
-    :data:`ORACLE_GRID`).
+    `ORACLE_GRID`).
     """
 
     def __init__(
@@ -413,9 +413,9 @@ class OracleDP:
 def dp_policy(env_id: str, lookahead: int = 1) -> Predictor:
     """The optimum for ``env_id``: DP on the known density, its continuous form, or the oracle.
 
-    The continuous variant's DP chooses among burns spaced by :data:`CONTINUOUS_DP_STEP_M_S`:
+    The continuous variant's DP chooses among burns spaced by `CONTINUOUS_DP_STEP_M_S`:
     a lower bound on its optimum, converging as the spacing shrinks (see the constant).
-    ``lookahead``: see :class:`orbit_env.agents.dp.DPPolicy` (not for the oracle).
+    ``lookahead``: see `orbit_env.agents.dp.DPPolicy` (not for the oracle).
     """
     from orbit_env.agents.dp import DPPolicy
 

@@ -18,7 +18,7 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
 from orbit_env.envs.task import OBS_INDEX
 
-#: Observation components it reads (the task model's layout, :data:`orbit_env.envs.task.OBS_INDEX`).
+#: Observation components it reads (the task model's layout, `orbit_env.envs.task.OBS_INDEX`).
 CLOCK, LIFETIME = OBS_INDEX["mission_clock"], OBS_INDEX["predicted_lifetime"]
 #: Clamp before the logarithms: a lifetime of about 30 s, a clock a step before 1 of a 365-step mission.
 LOG_FLOOR = 1e-6

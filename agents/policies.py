@@ -3,7 +3,7 @@
 Each answers Stable-Baselines3's ``predict(obs, state=None, episode_start=None,
 deterministic=True) -> (action, state)`` for one observation of shape (7,) or a batch
 (n, 7), in the discrete and the continuous variants alike. They recover the state
-from the observation with the task model (:func:`orbit_env.envs.task.decode`: the
+from the observation with the task model (`orbit_env.envs.task.decode`: the
 orbit, the propellant, the clock, and the satellite from the environment's config,
 as a flight engineer would) and plan with its functions at the nominal density.
 """
@@ -119,7 +119,7 @@ class Greedy(BurnPolicy):
 
     For each burn it could make now it computes, with the task model, the return of
     making that burn and then never burning again until the mission's end
-    (:func:`orbit_env.envs.task.lookahead`: the days in orbit within the mission
+    (`orbit_env.envs.task.lookahead`: the days in orbit within the mission
     minus the propellant's cost, at the nominal density), and takes the best, coasting
     when no burn buys more days than it costs.
     """

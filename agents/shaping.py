@@ -12,7 +12,7 @@ would still live within the mission if it coasted from s to the end,
 
     Phi(s) = (W(s) - W(s advanced by steps_left x K revolutions)) / (g c s x 1 day),
 
-with W = Int P dnu of the universal curves (:func:`orbit_env.envs.task.lookahead`
+with W = Int P dnu of the universal curves (`orbit_env.envs.task.lookahead`
 without a burn, over the rest of the mission, clamped at re-entry). Phi is 0 at re-entry (W = 0)
 and at the horizon (no steps left). A coasting step's shaped reward is then 0 up to
 rounding (the coast moves nu by the same amount the potential's coast does), and
@@ -30,7 +30,7 @@ this option). From such a state coasting is optimal, so its shaped optimal value
   burn can add only through a longer orbital period (the reward counts the days of
   K revolutions). The period a burn adds at once is at most max dP/dv per m/s, worth
   K x steps left times that, below the propellant's cost for the configs this
-  accepts (:func:`burns_cannot_pay_once_the_mission_is_covered` checks it over the
+  accepts (`burns_cannot_pay_once_the_mission_is_covered` checks it over the
   curves' whole domain: 0.30 day per m/s against a cost of 0.4 for the default
   task). That the decay does not widen the difference later (the raised, lighter
   satellite decays faster) is checked, not proven: the DP solved with every state
@@ -71,7 +71,7 @@ def outlook(task: Task, state: AnyState) -> tuple[FloatArray, NDArray[np.bool_]]
     """Phi and "decided" of every satellite of a state of the task model.
 
     Phi: the days never burning again still earns within the mission, at the
-    density of now (:func:`orbit_env.envs.task.lookahead` without a burn).
+    density of now (`orbit_env.envs.task.lookahead` without a burn).
     Decided: the tank is empty, or the satellite outlives the mission without
     another burn (see the module).
     """
@@ -84,7 +84,7 @@ def outlook(task: Task, state: AnyState) -> tuple[FloatArray, NDArray[np.bool_]]
 def period_gain_days_per_m_s(config: OrbitRaisingConfig) -> float:
     """The most mission days a perigee burn can add per m/s by lengthening the period alone.
 
-    :func:`orbit_env.envs.task.period_gain_days_per_m_s_per_step` for each
+    `orbit_env.envs.task.period_gain_days_per_m_s_per_step` for each
     of the mission's steps.
     """
     return period_gain_days_per_m_s_per_step(config.revolutions_per_step) * config.horizon_steps
@@ -102,7 +102,7 @@ class NeverBurnValueShaping(VecEnvWrapper):
     ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
 
     Args:
-        venv: The SB3 view of an orbit-raising vector env (:mod:`orbit_env.envs.sb3`).
+        venv: The SB3 view of an orbit-raising vector env (`orbit_env.envs.sb3`).
         end_decided: Probability that a step from a decided state ends its episode
             (0: never; see the module).
         seed: Seed of those draws.
@@ -169,5 +169,5 @@ class NeverBurnValueShaping(VecEnvWrapper):
 
 
 def never_burn_value_shaping(venv: Any, end_decided: float = 0.0, seed: int | None = None) -> NeverBurnValueShaping:
-    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with :class:`NeverBurnValueShaping`."""
+    """Wrap an SB3 ``VecEnv`` of an orbit-raising vector env with `NeverBurnValueShaping`."""
     return NeverBurnValueShaping(venv, end_decided=end_decided, seed=seed)

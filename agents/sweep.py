@@ -9,7 +9,7 @@ it stopped when run again with the same ``--out`` (finished trials are kept).
 
 Algorithms: ``ppo``, ``a2c``, ``dqn`` (discrete actions), ``sac``, ``td3`` (continuous)
 with Stable-Baselines3's defaults, and ``ppo_recipe``, the project's recipe (the TOML
-file of the shipped agent of the environment, :mod:`orbit_env.agents.train`).
+file of the shipped agent of the environment, `orbit_env.agents.train`).
 
 The table reports, per algorithm, rliable's interquartile mean (IQM) of the capture
 over the seeds, with a 95% bootstrap confidence interval (seeds resampled with

@@ -271,7 +271,7 @@ class BestModelCallback(BaseCallback):
 
     Every ``every_calls`` steps of the vector env it plays one episode per
     sub-environment of ``gymnasium.make_vec(env_id, num_envs=episodes, **env_kwargs)``
-    seeded with ``seed`` (:func:`orbit_env.agents.evaluate.run_episodes`: the
+    seeded with ``seed`` (`orbit_env.agents.evaluate.run_episodes`: the
     unshaped reward, deterministic actions), logs ``eval/mean_reward`` to
     tensorboard, saves the best so far to ``save_dir/best_model.zip`` and every
     score to ``save_dir/evaluations.json``. SB3's ``EvalCallback`` draws new
@@ -361,7 +361,7 @@ def train(
     The arguments other than ``config_path`` override the config. Episode returns go
     to tensorboard (``rollout/ep_rew_mean``, by SB3's ``VecMonitor``: with shaping,
     the shaped return PPO maximizes) and, with ``eval_every``, the plain env's mean
-    return on fixed validation episodes (``eval/mean_reward``, :class:`BestModelCallback`).
+    return on fixed validation episodes (``eval/mean_reward``, `BestModelCallback`).
 
     Args:
         config_path: TOML file of hyperparameters (default: the shipped one).

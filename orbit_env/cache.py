@@ -5,7 +5,7 @@ Each entry is one compressed ``.npz`` file of named arrays in the user's cache f
 under a name made from a hash of everything that shapes the table: its kind, a
 description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
 the package's source code (every module: the physics under a table changes
-with any of them), its version and :data:`FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
+with any of them), its version and `FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
 never read (old files stay until the cache folder is cleared).
 
 Writes are atomic: a table is written to a temporary file in the same folder and
@@ -17,7 +17,7 @@ Control:
 
 * the environment variable ``ORBIT_ENV_CACHE_DIR``: a folder to use instead, or
   ``off`` to disable the cache;
-* :func:`disable` (what ``orbit-env --no-cache`` calls) for the current process.
+* `disable` (what ``orbit-env --no-cache`` calls) for the current process.
 """
 
 from __future__ import annotations
@@ -115,7 +115,7 @@ def load(kind: str, description: str | None) -> dict[str, np.ndarray] | None:
 
     Args:
         kind: The kind of table (``"curves"``, ``"msis"``, ``"dp"``): the file's prefix.
-        description: What shapes the table (:func:`describe`); None: not cacheable.
+        description: What shapes the table (`describe`); None: not cacheable.
     """
     path = None if description is None else _path(kind, description)
     if path is None or not path.is_file():

@@ -1,9 +1,9 @@
 """The one validation helper of the public boundary: errors in the user's words.
 
 Every constructor, API function and CLI argument checks its numbers with
-:func:`check_number` (one value), :func:`check_int` (a count) or
-:func:`check_array` (arrays: the first bad element and its index). They raise
-:class:`InputError`, a ``ValueError`` whose message names the parameter, the value
+`check_number` (one value), `check_int` (a count) or
+`check_array` (arrays: the first bad element and its index). They raise
+`InputError`, a ``ValueError`` whose message names the parameter, the value
 as it was given (a plain number, never ``np.float64(...)``) and the allowed range
 in the parameter's own unit::
 
@@ -20,7 +20,7 @@ How to use it:
 * A bound that is another parameter (apogee >= perigee) is given as ``low=hp`` with
   ``low_name="perigee_km"``; the message shows both.
 * A front end whose words differ (the CLI's ``--perigee`` for ``perigee_km``) catches
-  :class:`InputError` and re-renders it with :meth:`InputError.message`
+  `InputError` and re-renders it with `InputError.message`
   (``label=``, ``value_text=``, ``scale=``, ``unit=``, ``rename=``): the error keeps
   the parameter's name, value, unit and bounds as data for that.
 
@@ -68,7 +68,7 @@ class InputError(ValueError):
     """A value at the public boundary that is not allowed; the message says which, and what is.
 
     The attributes keep the pieces, so a front end can say the same in its own
-    words (see :meth:`message`).
+    words (see `message`).
 
     Attributes:
         name: The parameter's name (``perigee_km``).
@@ -128,12 +128,12 @@ class InputError(ValueError):
         """The message, optionally in a front end's words.
 
         Args:
-            label: Name to show instead of :attr:`name` (``"--perigee"``). A label
+            label: Name to show instead of `name` (``"--perigee"``). A label
                 starting with ``-`` is followed by a space, a name by ``=``.
-            value_text: The value as the user typed it (default: :attr:`value`).
-            scale: Factor from :attr:`unit` to the shown unit, applied to the bounds
+            value_text: The value as the user typed it (default: `value`).
+            scale: Factor from `unit` to the shown unit, applied to the bounds
                 (and to the value if ``value_text`` is not given).
-            unit: The shown unit (default: :attr:`unit`).
+            unit: The shown unit (default: `unit`).
             rename: Maps the names of bounds taken from other parameters.
             show_index: Append the bad element's index to the label (a front end
                 that names the element its own way, say by a date, turns it off).
@@ -269,7 +269,7 @@ def check_number(
 
 
 def check_date(days: float, name: str, *, text: str | None = None) -> float:
-    """Check a date given as unix days (days since 1970-01-01) against :data:`DATE_RANGE`.
+    """Check a date given as unix days (days since 1970-01-01) against `DATE_RANGE`.
 
     Args:
         days: The date as unix days.
@@ -295,7 +295,7 @@ def check_int(value: Any, name: str, *, low: int | None = None, high: int | None
     """Check a count (a whole number, ``2`` or ``2.0``; not ``True``) and return it as an int.
 
     Raises:
-        InputError: as :func:`check_number` with ``integer=True``.
+        InputError: as `check_number` with ``integer=True``.
     """
     return int(check_number(value, name, low=low, high=high, integer=True, why=why))
 
@@ -321,7 +321,7 @@ def check_array(
     element) and its bound.
 
     Raises:
-        InputError: not numbers, NaN or infinite, or out of bounds; see :func:`check_number`.
+        InputError: not numbers, NaN or infinite, or out of bounds; see `check_number`.
     """
     bounds: dict[str, Any] = dict(
         unit=unit,

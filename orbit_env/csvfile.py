@@ -1,7 +1,7 @@
 """The user's CSV files as the user sees them: physical line numbers, an Excel BOM, binary files named.
 
 Every CSV reader of the package (batch catalogues, observed orbits, solar tables)
-reads through :func:`read_csv`, so their errors say the same things the same way:
+reads through `read_csv`, so their errors say the same things the same way:
 
 * every message starts with the file, and with the line when one line is at fault
   (``sats.csv, line 4: ...``), counting physical lines as an editor does: the header
@@ -11,7 +11,7 @@ reads through :func:`read_csv`, so their errors say the same things the same way
   name, not with a decoding error.
 
 Blank lines are skipped. A row with more cells than the header has columns keeps
-its extra cells in :attr:`Row.extra`; the caller decides (a batch reports the row,
+its extra cells in `Row.extra`; the caller decides (a batch reports the row,
 a solar table refuses the file). Trailing empty cells (``300,400,,``) are not extra.
 """
 

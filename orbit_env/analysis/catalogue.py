@@ -63,7 +63,7 @@ INCLINATION_STEP_DEG = 1.0
 #: Satellites per progress-bar step on the fixed-profile path.
 BLOCK = 20_000
 _ID_COLUMNS = ("name", "id")
-#: Key of a row's physical line in the rows of :func:`read_batch` (a header name is stripped of
+#: Key of a row's physical line in the rows of `read_batch` (a header name is stripped of
 #: spaces, so no column can be called this).
 LINE_KEY = " line"
 
@@ -78,7 +78,7 @@ class BatchSummary:
 
 
 def _number(row: dict[str, str], key: str, **bounds: Any) -> float | None:
-    """The cell ``key`` as a number checked against ``bounds`` (see :func:`check_number`); None if empty."""
+    """The cell ``key`` as a number checked against ``bounds`` (see `check_number`); None if empty."""
     text = row.get(key, "")
     if text == "":
         return None

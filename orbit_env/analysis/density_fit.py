@@ -5,7 +5,7 @@ SI units inside (m, s); observation files and results at the edge in km and days
 The paper notes that the lifetime is nearly inversely proportional to the density
 near the initial perigee, so an observed decay measures the real density. Here the
 measured quantity is a factor s on the chosen model's density (any atmosphere of a
-:class:`orbit_env.analysis.scenario.Scenario`). On a fixed profile s enters the decay only
+`orbit_env.analysis.scenario.Scenario`). On a fixed profile s enters the decay only
 through time: t = W / (g c s) (``orbit_env.decay.averaged``), so the decay follows the
 universal curves and s sets how fast.
 
@@ -253,7 +253,7 @@ def fit_density_scale(
 
     Args:
         observations: Observed orbits (the first is the start).
-        satellite: A :class:`orbit_env.analysis.lifetime.Satellite` (its drag parameter is used).
+        satellite: A `orbit_env.analysis.lifetime.Satellite` (its drag parameter is used).
         scenario: Atmosphere and activity whose density is scaled.
         inclination_deg: Orbit inclination.
         reentry: Observed re-entry (date, or days on the observations' time axis):
@@ -330,7 +330,7 @@ def fit_density_scale(
 def _plausible(fit: DensityFit) -> DensityFit:
     """The fit, if its scale is one an atmosphere can have; else an error saying what that means.
 
-    A scale outside :data:`~orbit_env.analysis.scenario.DENSITY_SCALE_RANGE` (or not finite)
+    A scale outside `DENSITY_SCALE_RANGE` (or not finite)
     says that the data do not fit this satellite in this atmosphere: a wrong mass or area,
     heights or times mistyped, or an orbit raised by a burn between two observations.
     """

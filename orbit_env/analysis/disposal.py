@@ -47,7 +47,7 @@ def perigee_lowering_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, new_perig
 
 @dataclass(frozen=True)
 class RuleCheck:
-    """Outcome of :func:`check_disposal_rule`, arrays over satellites.
+    """Outcome of `check_disposal_rule`, arrays over satellites.
 
     Attributes:
         rule_years: The limit.
@@ -78,7 +78,7 @@ def check_disposal_rule(
         perigee_m: Perigee heights [m].
         apogee_m: Apogee heights [m].
         rule_years: Re-entry must come within this many years.
-        lifetime_days: Vectorized lifetimes (see :data:`LifetimeFunction`).
+        lifetime_days: Vectorized lifetimes (see `LifetimeFunction`).
 
     Raises:
         ValueError: ``rule_years`` not positive.

@@ -213,7 +213,7 @@ def parse_tle_text(lines: Iterable[str], source: str = "TLE") -> list[ElementSet
 
 
 def read_tle(path: str | Path) -> list[ElementSet]:
-    """The element sets of a file (``-``: standard input); see :func:`parse_tle_text`.
+    """The element sets of a file (``-``: standard input); see `parse_tle_text`.
 
     Raises:
         ValueError: a malformed set, naming the line.

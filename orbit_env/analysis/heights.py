@@ -1,6 +1,6 @@
 """What a height is measured from: the WGS84 equatorial radius or the paper's 6371 km sphere.
 
-The decay core (:mod:`orbit_env.physics.orbit`) measures heights above the paper's
+The decay core (`orbit_env.physics.orbit`) measures heights above the paper's
 spherical Earth of radius ``EARTH_RADIUS_M`` = 6371 km, which reproduces the paper's
 Table II. Catalogues and element sets quote heights above the WGS84 equatorial radius
 6378.137 km (``a (1 - e) - 6378.137 km``). This module converts at the edge:
@@ -11,9 +11,9 @@ Table II. Catalogues and element sets quote heights above the WGS84 equatorial r
   paper's numbers stay as printed.
 
 NRLMSIS already evaluates its density at the geodetic altitude of every sample on the
-orbit (:func:`orbit_env.physics.atmosphere.msis.geodetic_altitude_m`), so for it only
+orbit (`orbit_env.physics.atmosphere.msis.geodetic_altitude_m`), so for it only
 the radius changes. The exponential law rho0 exp(-(h - h0) / H) is made to do the same by
-:func:`exponential_at_geodetic_altitude`. Re-entry stays at a perigee 100 km above the
+`exponential_at_geodetic_altitude`. Re-entry stays at a perigee 100 km above the
 sphere (92.9 km above the equator), where a satellite has hours left.
 
 Units: km (the user's), converted nowhere else.

@@ -202,7 +202,7 @@ def make_satellite(
     area_m2: float | None = None,
     mass_per_area_kg_m2: float | None = None,
 ) -> Satellite:
-    """Build a :class:`Satellite` from the CLI's options (defaults: the paper's sphere)."""
+    """Build a `Satellite` from the CLI's options (defaults: the paper's sphere)."""
     if mass_per_area_kg_m2 is not None:
         if mass_kg is not None or area_m2 is not None:
             raise ValueError("give either --mass-per-area or --mass and --area, not both")
@@ -247,10 +247,10 @@ def lifetime(
         inclination_deg: Orbit inclination (matters with a rotating atmosphere,
             and sets the latitudes NRLMSIS is averaged over).
         activity: Use NRLMSIS 2.1 under this solar activity
-            (:mod:`orbit_env.decay.solar`; needs pymsis). Constant activity without an
+            (`orbit_env.decay.solar`; needs pymsis). Constant activity without an
             epoch is one fixed profile (every method); otherwise the satellite is
             stepped through time on the universal curves (``method="curves"``,
-            :mod:`orbit_env.decay.chunked`) or, as a slow reference, by the averaged
+            `orbit_env.decay.chunked`) or, as a slow reference, by the averaged
             equations with a fresh profile every day (``method="averaged"``).
         epoch: Date of the orbit (``YYYY-MM-DD``, or unix days). With NRLMSIS it
             makes the season count, and places the orbit in time-varying activity.
@@ -385,7 +385,7 @@ def check_lifetime_days(days: float) -> float:
     """A lifetime the models can answer for, in days; else an error saying how long it came out.
 
     Raises:
-        ValueError: ``days`` is not finite or exceeds :data:`MAX_LIFETIME_YEARS`.
+        ValueError: ``days`` is not finite or exceeds `MAX_LIFETIME_YEARS`.
     """
     if not (math.isfinite(days) and days <= MAX_LIFETIME_YEARS * 365.25):
         raise ValueError(
@@ -406,7 +406,7 @@ def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
 def _lifetime_under_activity(
     hp_m: float, ha_m: float, satellite: Satellite, method: str, scale: float, model: SolarDecayModel
 ) -> LifetimeResult:
-    """The time-stepped NRLMSIS lifetime (see :func:`lifetime`; the caller checked the heights)."""
+    """The time-stepped NRLMSIS lifetime (see `lifetime`; the caller checked the heights)."""
     if method == "direct":
         raise ValueError("the direct method needs a fixed atmosphere; with changing solar activity use curves")
     c = satellite.drag_parameter_m2_kg
@@ -456,7 +456,7 @@ def check_rule(
     The burn is a retrograde burn at apogee that lowers the perigee (the apogee stays).
 
     Lifetimes come from the universal curves of the scenario (time-stepped if it
-    has an epoch), see :mod:`orbit_env.analysis.disposal`. Above the curves' domain
+    has an epoch), see `orbit_env.analysis.disposal`. Above the curves' domain
     (perigee > 1100 km or apogee > 4000 km: a GTO, a Molniya orbit) a fixed atmosphere's
     lifetimes come from the averaged equations instead (one integration per candidate
     perigee, 49 in all; the same equations as ``lifetime(method="averaged")``, so the

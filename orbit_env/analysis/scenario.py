@@ -1,10 +1,10 @@
 """A decay scenario: the atmosphere and the solar activity, shared by single lifetimes, batches and fits.
 
-SI units inside. A :class:`Scenario` turns the user's choice (the paper's law, an
+SI units inside. A `Scenario` turns the user's choice (the paper's law, an
 exponential law, or NRLMSIS under constant, tabulated or cyclic activity) into
 lifetimes of arrays of satellites through the fast paths: the universal curves of
 one fixed profile, or, when the activity changes over the lifetime (or the season
-is to be followed), the chunked curves of :mod:`orbit_env.decay.chunked`.
+is to be followed), the chunked curves of `orbit_env.decay.chunked`.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def check_curves_density(atmosphere: Atmosphere) -> None:
     """Refuse, in the user's terms, an atmosphere too dense at 100 km for the universal curves.
 
     Raises:
-        ValueError: its density at 100 km exceeds :data:`CURVES_MAX_RHO100_KG_M3`.
+        ValueError: its density at 100 km exceeds `CURVES_MAX_RHO100_KG_M3`.
     """
     rho = float(np.asarray(atmosphere.density_kg_m3(REENTRY_ALTITUDE_M)))
     if not rho <= CURVES_MAX_RHO100_KG_M3:
@@ -62,7 +62,7 @@ class Scenario:
         rho100_kg_m3: Paper law: density at 100 km (None: calibrated value).
         density_scale: Multiplier on any model's density.
         rho0_kg_m3: Exponential law: density at ``h0_m`` (default: the orbital-height law
-            :data:`~orbit_env.physics.atmosphere.exponential.ORBITAL_LAW`).
+            `ORBITAL_LAW`).
         h0_m: Exponential law: reference height.
         scale_height_m: Exponential law: scale height.
         activity: NRLMSIS: indices against time (default: F10.7 = 150, Ap = 15, constant).
@@ -132,14 +132,14 @@ class Scenario:
         )
 
     def decay_model(self, inclination_deg: float) -> DecayModel:
-        """The fixed-profile decay model (see :meth:`fixed_atmosphere`)."""
+        """The fixed-profile decay model (see `fixed_atmosphere`)."""
         return DecayModel(self.fixed_atmosphere(inclination_deg), self.rotating_atmosphere, inclination_deg)
 
     def curves(self, inclination_deg: float) -> UniversalCurves:
         """The universal curves of the fixed profile (cached per profile).
 
         Raises:
-            ValueError: the profile is too dense at 100 km for the curves (:func:`check_curves_density`).
+            ValueError: the profile is too dense at 100 km for the curves (`check_curves_density`).
         """
         model = self.decay_model(inclination_deg)
         check_curves_density(model.atmosphere)

@@ -1,9 +1,9 @@
 """A satellite's shape -> its free-molecular drag coefficient at the orbit's conditions (needs pymsis).
 
-The coefficient comes from :mod:`orbit_env.physics.drag` (Sentman 1961, diffuse
+The coefficient comes from `orbit_env.physics.drag` (Sentman 1961, diffuse
 re-emission, full energy accommodation, wall at 300 K). The gas's speed ratio and
 temperature are NRLMSIS 2.1's at the start: at the orbit's mean height, over its
-latitudes and local times (:func:`orbit_env.physics.atmosphere.msis.orbit_samples`),
+latitudes and local times (`orbit_env.physics.atmosphere.msis.orbit_samples`),
 on the epoch's date with its indices, the coefficient density-weighted over these
 samples; it is then held for the whole life (along a decay from 500 km it falls by a
 few per cent, see docs/validation-modern.md).
@@ -94,7 +94,7 @@ def drag_at_start(
         height_m: The orbit's mean height above the 6371 km sphere.
         inclination_deg: The orbit's inclination (sets the latitudes sampled).
         indices: F10.7, its 81-day mean [sfu] and Ap of the date.
-        date: ISO date and time (None: :data:`DEFAULT_GAS_DATE`).
+        date: ISO date and time (None: `DEFAULT_GAS_DATE`).
         ascending_node_local_time_h: Sun-synchronous orbits: the node's local time.
         rotating_atmosphere: Whether the speed is taken against co-rotating air.
     """

@@ -1,30 +1,30 @@
 """Lifetime with its uncertainty: Monte Carlo over the solar forecast, the density model and the drag coefficient.
 
 Units: SI inside (m, days); the public function takes heights in m above the package's
-6371 km sphere, as :meth:`orbit_env.analysis.scenario.Scenario.lifetime_days` does.
+6371 km sphere, as `orbit_env.analysis.scenario.Scenario.lifetime_days` does.
 
 Three sources, independent, each a log-normal factor (sigma in the natural log):
 
-* **the solar forecast** (:data:`SOLAR_FORECAST_SIGMA`): F10.7 and its 81-day mean after
+* **the solar forecast** (`SOLAR_FORECAST_SIGMA`): F10.7 and its 81-day mean after
   the last observed day are multiplied by exp(sigma z). The record's monthly forecast
   (NOAA SWPC's predicted cycle, as CelesTrak carries it) states no spread in the file; 0.15
   is our reading of the spread of published cycle predictions (the NASA/NOAA Solar Cycle
   25 Prediction Panel's and NASA MSFC's bands are about +-25-30% of the smoothed F10.7 at
   95%; figures from memory, not checked against a source here). Observed days are not
   varied. Without an epoch (a constant, user-given activity) this source is left out;
-* **the density model** (:data:`DENSITY_MODEL_SIGMA`): NRLMSIS's own error, a factor on
+* **the density model** (`DENSITY_MODEL_SIGMA`): NRLMSIS's own error, a factor on
   the density held for the whole life. Emmert et al. (2021, Earth and Space Science,
   "NRLMSIS 2.0: A whole-atmosphere empirical model of temperature and neutral species
   densities") compare the model with satellite-drag densities; 0.15 is our reading of the
   10-20% standard deviations of such comparisons (from memory, not checked here);
-* **the drag coefficient** (:data:`DRAG_COEFFICIENT_SIGMA`): 0.10, for the accommodation
+* **the drag coefficient** (`DRAG_COEFFICIENT_SIGMA`): 0.10, for the accommodation
   and attitude a free-molecular coefficient assumes, or the fit error of a B*.
 
 Everything goes through the fast paths: a fixed profile's lifetime is inversely
 proportional to the density scale and the drag coefficient (Eq. 3.4: the decay rate is
 linear in rho c), so the samples of a fixed profile are one lifetime divided by their
-factors, exactly. With an epoch, the time-stepped decay (:mod:`orbit_env.decay.chunked`)
-runs once per solar node (:data:`SOLAR_NODES`, values of z) with all samples at once, a
+factors, exactly. With an epoch, the time-stepped decay (`orbit_env.decay.chunked`)
+runs once per solar node (`SOLAR_NODES`, values of z) with all samples at once, a
 vector of satellites each with its own density and drag factor; each sample's lifetime
 is then interpolated in z between the two nodes around it (linearly in log days). The
 interpolation error is measured in ``tests/test_uncertainty.py`` against samples
@@ -145,7 +145,7 @@ def lifetime_spread(
         perigee_m: Perigee height above the 6371 km sphere.
         apogee_m: Apogee height above the sphere.
         drag_parameter_m2_kg: c = c_x A / m.
-        scenario: The :class:`~orbit_env.analysis.scenario.Scenario`.
+        scenario: The `Scenario`.
         inclination_deg: The orbit's inclination.
         samples: Number of samples.
         seed: Seed of the random numbers.

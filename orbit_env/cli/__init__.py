@@ -2,8 +2,8 @@
 
 Lifetimes (one orbit or a CSV batch), disposal rules, density fits, Table II, Fig. 2,
 training and evaluating agents.
-One module per group of commands (:mod:`~orbit_env.cli.lifetime`, :mod:`~orbit_env.cli.paper`,
-:mod:`~orbit_env.cli.agents`), sharing :mod:`~orbit_env.cli.common`. Every error a user can
+One module per group of commands (`lifetime`, `paper`,
+`agents`), sharing `common`. Every error a user can
 cause ends in one line on stderr and exit status 2, in the command line's words.
 """
 

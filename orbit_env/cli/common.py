@@ -1,8 +1,8 @@
 """What every ``orbit-env`` command shares: one-line errors, numbers that remember how they were typed, flags.
 
 An error in a value names the flag and the value as typed (``--perigee 50 is out of
-range; allowed: 100 to 50000 km``): the API raises :class:`orbit_env.checks.InputError`
-naming its parameter, and :data:`FLAGS` maps the parameter to the flag at one place.
+range; allowed: 100 to 50000 km``): the API raises `orbit_env.checks.InputError`
+naming its parameter, and `FLAGS` maps the parameter to the flag at one place.
 """
 
 from __future__ import annotations
@@ -79,9 +79,9 @@ def number(text: str) -> float:
 
 number.__name__ = "number"  # argparse says "invalid number value: 'abc'"
 
-#: The API's parameter names (as :class:`~orbit_env.checks.InputError` gives them) -> the flag's
+#: The API's parameter names (as `InputError` gives them) -> the flag's
 #: argparse dest and, for a flag in other units than the parameter, the factor to the flag's unit and
-#: that unit. ``scale`` is an atmosphere's, ``phase`` :meth:`CycleActivity.with_phase`'s.
+#: that unit. ``scale`` is an atmosphere's, ``phase`` `CycleActivity.with_phase`'s.
 FLAGS: dict[str, tuple[str, float, str | None]] = {
     "perigee_km": ("perigee", 1.0, None),
     "apogee_km": ("apogee", 1.0, None),

@@ -1,8 +1,8 @@
 """``orbit-env lifetime`` (one orbit or a CSV catalogue) and ``orbit-env fit-density``: the analyst's commands.
 
 Heights are in km here and converted to SI at once; the batch CSV format is in
-:mod:`orbit_env.analysis.catalogue`, the solar CSV format in :mod:`orbit_env.decay.solar`,
-the observations of ``fit-density`` in :mod:`orbit_env.analysis.density_fit`.
+`orbit_env.analysis.catalogue`, the solar CSV format in `orbit_env.decay.solar`,
+the observations of ``fit-density`` in `orbit_env.analysis.density_fit`.
 """
 
 from __future__ import annotations
@@ -128,9 +128,9 @@ def _atmosphere(args: argparse.Namespace, scenario: Scenario) -> str:
 def _warn_solar_table(scenario: Scenario, last_day: float) -> None:
     """Warn on stderr when a solar table does not cover the decay, from the epoch to ``last_day`` [unix days].
 
-    Outside its rows a table's first or last row is held (:class:`TableActivity`); the warning gives
+    Outside its rows a table's first or last row is held (`TableActivity`); the warning gives
     the dates and says that this is what was done. Hook: once a shipped record and forecast can
-    extend a table, extend it in :func:`_scenario` and say so here instead.
+    extend a table, extend it in `_scenario` and say so here instead.
     """
     solar = scenario.activity
     if not isinstance(solar, TableActivity) or scenario.epoch_days is None or not math.isfinite(last_day):

@@ -7,7 +7,7 @@ Shared by ``orbit-env lifetime`` and ``fit-density``. The orbit comes from one o
 * ``--tle FILE`` (a two- or three-line element set, ``-`` for stdin): epoch, mean elements,
   inclination and, unless the satellite is given, the drag parameter from B*.
 
-Heights are converted to the decay core's 6371 km sphere here (:mod:`orbit_env.analysis.heights`)
+Heights are converted to the decay core's 6371 km sphere here (`orbit_env.analysis.heights`)
 and back for what is printed. Heavy imports (sgp4, pymsis) happen inside the functions.
 """
 

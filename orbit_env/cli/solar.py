@@ -3,7 +3,7 @@
 ``orbit-env solar show`` says which record is in use and what it covers;
 ``orbit-env solar update FILE`` imports a newer CelesTrak space-weather file
 (``SW-All.txt`` from https://celestrak.org/SpaceData/) that the user downloaded.
-Nothing is downloaded here. See :mod:`orbit_env.decay.solar_record`.
+Nothing is downloaded here. See `orbit_env.decay.solar_record`.
 """
 
 from __future__ import annotations

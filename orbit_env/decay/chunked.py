@@ -1,6 +1,6 @@
 """Decay under solar activity that changes over the lifetime, on the universal curves. SI units.
 
-The universal curves (:mod:`orbit_env.decay.curves`) belong to one fixed density profile.
+The universal curves (`orbit_env.decay.curves`) belong to one fixed density profile.
 NRLMSIS's profile changes with F10.7, Ap and the season, over days to years, so a
 decay that spans a solar cycle cannot follow one family of curves. We step the
 satellites through time in chunks (``chunk_days``, default 20 days); in each chunk
@@ -25,8 +25,8 @@ satellites through time in chunks (``chunk_days``, default 20 days); in each chu
    dt g c s (``orbit_env.decay.averaged``), solved for nu by Newton's method with
    dW/dnu = P (the Keplerian period). If W left is smaller, it re-enters within
    the chunk;
-5. near re-entry (less than :data:`FINE_CHUNKS` chunks of decay left at the chunk's
-   rate) a chunk goes one day at a time (:data:`FINISH_STEP_DAYS`), each day with its
+5. near re-entry (less than `FINE_CHUNKS` chunks of decay left at the chunk's
+   rate) a chunk goes one day at a time (`FINISH_STEP_DAYS`), each day with its
    own density multiplier at that day's perigee, so the last weeks, where the perigee
    falls fastest, are resolved (and recorded) day by day. With one multiplier per
    chunk, taken at the chunk's start height, lives of a few weeks came out 0.5-3.4%
@@ -35,7 +35,7 @@ satellites through time in chunks (``chunk_days``, default 20 days); in each chu
 Satellites are re-located on the curves only when the bin changes. Everything is
 vectorized over satellites. The measured effect of the chunk length and the bin
 step against a day-by-day integration of the averaged equations
-(:func:`integrate_reference`) is in ``docs/validation-modern.md``.
+(`integrate_reference`) is in ``docs/validation-modern.md``.
 """
 
 from __future__ import annotations
@@ -131,14 +131,14 @@ class SolarDecayModel:
     """What a decay under changing solar activity depends on, apart from the satellite.
 
     Args:
-        activity: Indices against time (:mod:`orbit_env.decay.solar`).
+        activity: Indices against time (`orbit_env.decay.solar`).
         start_days: Unix days of the start (the epoch of the orbit).
         inclination_deg: Orbit inclination (latitudes of the NRLMSIS average,
             and the co-rotating air if ``rotating_atmosphere``).
         follow_season: Use each chunk's day of the year (else the year's average).
         rotating_atmosphere: Let the air co-rotate with the Earth.
         ascending_node_local_time_h: For Sun-synchronous orbits (see
-            :class:`orbit_env.physics.atmosphere.msis.MsisAtmosphere`).
+            `orbit_env.physics.atmosphere.msis.MsisAtmosphere`).
         chunk_days: Length of a time step.
         bin_step: Bin width in ln(81-day mean F10.7).
         max_years: Stop propagating after this long.
@@ -201,7 +201,7 @@ class SolarDecayModel:
 
 @dataclass(frozen=True)
 class SolarLifetime:
-    """Result of :func:`propagate`, arrays over satellites.
+    """Result of `propagate`, arrays over satellites.
 
     Attributes:
         days: Time from the start to re-entry [days]; ``max_years`` in days where not re-entered.
@@ -257,7 +257,7 @@ def _daily_steps(
     ha: FloatArray,
     t0: float,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, tuple[list[float], list[FloatArray], list[FloatArray]]]:
-    """The chunk from ``t0`` one day (:data:`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
+    """The chunk from ``t0`` one day (`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
 
     Each day takes its own indices' density multiplier at that day's perigee. Returns the
     re-entry day (NaN for a satellite still up at the chunk's end), nu and the heights at
@@ -432,7 +432,7 @@ def integrate_reference(
     profile (orbit-averaged NRLMSIS at the day's indices and day of year) is
     recomputed every ``profile_step_days`` and its logarithm interpolated
     linearly in time; dp/dt and de/dt are the averaged rates of
-    :mod:`orbit_env.decay.averaged` times dnu/dt = g c / P. Slow: ~25 ms per profile.
+    `orbit_env.decay.averaged` times dnu/dt = g c / P. Slow: ~25 ms per profile.
     """
     solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
     if solution.status != 1:
@@ -448,7 +448,7 @@ def _solve_reference(
     profile_step_days: float,
     rtol: float,
 ) -> Any:
-    """The ``solve_ivp`` solution behind :func:`integrate_reference` and :func:`reference_path`."""
+    """The ``solve_ivp`` solution behind `integrate_reference` and `reference_path`."""
     profiles: dict[int, FloatArray] = {}
 
     def log_profile(index: int) -> FloatArray:
@@ -505,7 +505,7 @@ def reference_path(
     profile_step_days: float = 1.0,
     rtol: float = 1e-8,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The decay of :func:`integrate_reference` as it goes: days, perigee [m] and apogee [m] at its steps.
+    """The decay of `integrate_reference` as it goes: days, perigee [m] and apogee [m] at its steps.
 
     The last point is the re-entry (perigee 100 km), or the state at ``max_years``.
     """

@@ -145,7 +145,7 @@ class _Grid:
         At a fixed x the bilinear form is linear in y within a cell:
         f = (c0 + c1 tx) + (c2 + c3 tx) ty. Returns a (1 + 2k, n) array: the cell
         index j (as a float), then the k bases c0 + c1 tx, then the k slopes
-        c2 + c3 tx; and ty, where y is in its cell. :meth:`along` evaluates them.
+        c2 + c3 tx; and ty, where y is in its cell. `along` evaluates them.
         """
         cell, tx, j, ty = self._cells(x, y)
         out = np.empty((1 + 2 * self.k, *tx.shape))
@@ -158,7 +158,7 @@ class _Grid:
         return out, ty
 
     def along(self, segments: FloatArray, ty: FloatArray) -> list[FloatArray]:
-        """The k tables at ``ty`` of the way across each point's cell (see :meth:`segments`)."""
+        """The k tables at ``ty`` of the way across each point's cell (see `segments`)."""
         out = []
         for m in range(self.k):
             value = segments[1 + self.k + m] * ty
@@ -167,16 +167,16 @@ class _Grid:
         return out
 
     def on_segments(self, segments: FloatArray, x: FloatArray, y: FloatArray) -> list[FloatArray]:
-        """:meth:`values` at (x, y) for points whose x has not changed since ``segments`` was made.
+        """`values` at (x, y) for points whose x has not changed since ``segments`` was made.
 
         Points whose y has left its cell get a fresh segment, written into
-        ``segments`` in place. Equal to :meth:`values` up to round-off (the same
+        ``segments`` in place. Equal to `values` up to round-off (the same
         bilinear form, its terms grouped differently).
         """
         fy = np.asarray(np.multiply(y, self.y_scale))
         if self.y_offset:
             fy -= self.y_offset
-        # No clamps: a y beyond the grid is outside its cell, and :meth:`segments` clamps it.
+        # No clamps: a y beyond the grid is outside its cell, and `segments` clamps it.
         ty = fy - segments[0]
         moved = np.flatnonzero((ty < 0.0) | (ty > 1.0))
         if moved.size:
@@ -184,7 +184,7 @@ class _Grid:
         return self.along(segments, ty)
 
     def values_scalar(self, x: float, y: float) -> list[float]:
-        """:meth:`values` for one point, in plain floats.
+        """`values` for one point, in plain floats.
 
         The single environment steps one orbit at a time, where numpy's per-call
         cost on 0-d arrays is ten times the arithmetic.
@@ -266,9 +266,9 @@ def _check_curve_limits(hp: FloatArray, ha: FloatArray, names: tuple[str, str], 
 
 
 class UniversalCurves:
-    """The family of decay curves of one :class:`DecayModel`, as lookup tables.
+    """The family of decay curves of one `DecayModel`, as lookup tables.
 
-    Build it with :func:`universal_curves` (cached per model). All methods take and
+    Build it with `universal_curves` (cached per model). All methods take and
     return SI arrays and broadcast.
 
     The curves are integrated backward from re-entry, one every 0.1 in the label
@@ -409,7 +409,7 @@ class UniversalCurves:
 
     @staticmethod
     def check_domain_km(perigee_km: ArrayLike, apogee_km: ArrayLike) -> tuple[FloatArray, FloatArray]:
-        """:meth:`check_domain` for heights in km (checked, and named, in km); returns metres."""
+        """`check_domain` for heights in km (checked, and named, in km); returns metres."""
         hp, ha = validate_heights_km(perigee_km, apogee_km)
         typed = np.broadcast_arrays(np.asarray(perigee_km, dtype=np.float64), np.asarray(apogee_km, dtype=np.float64))
         _check_curve_limits(*typed, ("perigee_km", "apogee_km"), "km", 1e3)
@@ -420,9 +420,9 @@ class UniversalCurves:
         return self._with_period(*self._label_tau(perigee_m, apogee_m))
 
     def locate_heights(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[CurvePoint, FloatArray, FloatArray]:
-        """:meth:`locate`, and the perigee and apogee heights [m] the curves give the located point.
+        """`locate`, and the perigee and apogee heights [m] the curves give the located point.
 
-        The counterpart of :meth:`advance_heights` for a simulator that observes
+        The counterpart of `advance_heights` for a simulator that observes
         heights: reading them from the same table before and after a coast makes
         the decay it sees one table's difference, free of the locate-and-read-back
         round trip's interpolation error (up to 0.1 km in perigee, 1.3 km in apogee).
@@ -434,9 +434,9 @@ class UniversalCurves:
     def locate_segments(
         self, perigee_m: ArrayLike, apogee_m: ArrayLike
     ) -> tuple[CurvePoint, FloatArray, FloatArray, FloatArray]:
-        """:meth:`locate_heights` for arrays, and where the located orbits are on table B.
+        """`locate_heights` for arrays, and where the located orbits are on table B.
 
-        The last value (a (7, n) array) is for :meth:`advance_heights` to keep
+        The last value (a (7, n) array) is for `advance_heights` to keep
         between steps. An orbit coasts along one curve (fixed label) and its tau
         falls by a small part of a table cell per step (in the env's defaults 4-7%
         of satellites change cell in a step), so keeping each orbit's cell and the
@@ -478,7 +478,7 @@ class UniversalCurves:
         return _heights(mu, *self._table_b.values(mu, tau))
 
     def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
-        """:meth:`at` for one orbit, in plain floats (the arithmetic of :func:`_heights`)."""
+        """`at` for one orbit, in plain floats (the arithmetic of `_heights`)."""
         b0, b1, b2 = self._table_b.values_scalar(mu, tau)
         hp = max(b0, REENTRY_ALTITUDE_M)
         e = math.exp(b1 + mu)
@@ -502,11 +502,11 @@ class UniversalCurves:
     def advance_heights(
         self, point: CurvePoint, dnu: ArrayLike, segments: FloatArray | None = None
     ) -> tuple[CurvePoint, FloatArray, FloatArray]:
-        """:meth:`advance`, and the perigee and apogee heights [m] of the new point.
+        """`advance`, and the perigee and apogee heights [m] of the new point.
 
         The same as ``advance`` followed by ``at``, in one interpolation: what a
         simulator stepping many orbits and observing their heights needs. With
-        ``segments`` (from :meth:`locate_segments`, for these orbits' labels) the
+        ``segments`` (from `locate_segments`, for these orbits' labels) the
         interpolation uses and updates them in place.
         """
         if segments is None and isinstance(dnu, float) and isinstance(point.tau, float):

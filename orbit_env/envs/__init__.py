@@ -8,8 +8,8 @@
 
 Each has a single environment (``gymnasium.make``) and a numpy-batched vector
 environment (``gymnasium.make_vec(id, num_envs=N)``, autoreset ``NEXT_STEP`` by default);
-:mod:`orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
-is the docstring of :class:`OrbitRaisingEnv`.
+`orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
+is the docstring of `OrbitRaisingEnv`.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Frozen dataclasses checked at construction (``ValueError`` naming the field and 
 allowed range); derived quantities (wet mass, exhaust velocity, delta-v capacity)
 are properties. SI units except where a name says otherwise (``_km``, ``_days``,
 ``_s`` for the specific impulse in seconds). The decision problem built on them is
-:mod:`orbit_env.envs.task`.
+`orbit_env.envs.task`.
 """
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ class OrbitRaisingConfig:
     """Satellite, task and start distribution of the orbit-raising environments.
 
     All defaults are chosen together so that the decision depends on the state
-    (see :class:`OrbitRaisingEnv`, "Why these defaults").
+    (see `OrbitRaisingEnv`, "Why these defaults").
 
     Args:
         drag_coefficient: c_x, the drag coefficient (2.2, the usual value for a
@@ -213,7 +213,7 @@ def validate_satellite(
 
 
 #: The flat keywords of ``gymnasium.make`` and ``gymnasium.make_vec``: every field of
-#: :class:`OrbitRaisingConfig` and of :class:`DensityConfig` (their names do not overlap).
+#: `OrbitRaisingConfig` and of `DensityConfig` (their names do not overlap).
 CONFIG_FIELDS = tuple(f.name for f in fields(OrbitRaisingConfig))
 DENSITY_FIELDS = tuple(f.name for f in fields(DensityConfig))
 
@@ -247,8 +247,8 @@ def resolve_task_arguments(
     ``scale_range=(0.1, 10)``) then replaces that field.
 
     Args:
-        config: An :class:`OrbitRaisingConfig`, a dict of its fields, or None.
-        density: A :class:`DensityConfig`, a dict of its fields, or None.
+        config: An `OrbitRaisingConfig`, a dict of its fields, or None.
+        density: A `DensityConfig`, a dict of its fields, or None.
         keywords: Flat keywords, each a field of either.
         env_keywords: The environment's other keywords, listed in the error message.
 

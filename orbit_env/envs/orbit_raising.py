@@ -1,6 +1,6 @@
 """The single orbit-raising environment: one satellite, the task model on Python floats.
 
-The decision problem (burn, coast, reward, observation) is :mod:`orbit_env.envs.task`;
+The decision problem (burn, coast, reward, observation) is `orbit_env.envs.task`;
 this module adds what Gymnasium asks of an environment: spaces, seeding, the
 reset options, rendering. Its class docstring is the user's manual.
 """
@@ -98,7 +98,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     ## Arguments
 
-    Every field of :class:`OrbitRaisingConfig` and :class:`DensityConfig` is a
+    Every field of `OrbitRaisingConfig` and `DensityConfig` is a
     flat keyword, as LunarLander's ``gravity=``:
     ``gymnasium.make("OrbitRaising-v0", horizon_steps=100, area_m2=2.0)``,
     ``gymnasium.make("OrbitRaisingUncertain-v0", scale_range=(0.5, 2.0))``. A
@@ -107,7 +107,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     then replace single fields. An unknown keyword is a ``ValueError`` that names it
     and lists the valid ones. Besides: ``continuous=False`` and ``render_mode=None``.
     The same keywords for ``gymnasium.make_vec(id, num_envs=N)``, the numpy-batched
-    version (:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`), which also takes
+    version (`orbit_env.envs.vector.OrbitRaisingVectorEnv`), which also takes
     ``autoreset_mode``.
     ``render_mode``: "human" and "rgb_array" draw the (apogee, perigee) plane of
     the paper's Fig. 2 with the track and the burns (needs ``orbit-env[plot]``);
@@ -205,7 +205,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     @property
     def task_state(self) -> TaskState:
-        """The task model's state of the satellite (:class:`orbit_env.envs.task.TaskState`; live, not a copy)."""
+        """The task model's state of the satellite (`orbit_env.envs.task.TaskState`; live, not a copy)."""
         if self._state is None:
             raise RuntimeError("the environment has no state before reset()")
         return self._state

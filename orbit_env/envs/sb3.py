@@ -1,9 +1,9 @@
 """Stable-Baselines3 on the numpy-batched vector environment, without a wrapper per satellite.
 
-SB3 trains on its own ``VecEnv`` interface; :class:`SB3VecEnv` presents a Gymnasium
+SB3 trains on its own ``VecEnv`` interface; `SB3VecEnv` presents a Gymnasium
 vector environment that resets finished episodes in the same step
-(``AutoresetMode.SAME_STEP``, which :func:`make_sb3_vec_env` asks of
-:class:`orbit_env.envs.vector.OrbitRaisingVectorEnv`) through it: one numpy step
+(``AutoresetMode.SAME_STEP``, which `make_sb3_vec_env` asks of
+`orbit_env.envs.vector.OrbitRaisingVectorEnv`) through it: one numpy step
 for all satellites instead of ``DummyVecEnv``'s Python loop over single environments.
 Needs ``pip install 'orbit-env[train]'``.
 
@@ -80,7 +80,7 @@ class SB3VecEnv(VecEnv):
         return {key: np.array([o[key] for o in options]) for key in keys}
 
     def step_async(self, actions: np.ndarray) -> None:
-        """Store the actions for :meth:`step_wait`."""
+        """Store the actions for `step_wait`."""
         self._actions = actions
 
     def step_wait(self) -> VecEnvStepReturn:
@@ -134,7 +134,7 @@ def make_sb3_vec_env(
     """``gymnasium.make_vec`` of a registered orbit_env id, ready for Stable-Baselines3.
 
     Args:
-        env_id: A registered id (see :mod:`orbit_env.envs`).
+        env_id: A registered id (see `orbit_env.envs`).
         num_envs: Number of satellites stepped together.
         seed: Seed of the first reset (None: unseeded).
         **kwargs: Passed to the environment (``config``, ``density``, ...).

@@ -2,28 +2,28 @@
 
 SI units inside (m, kg, s, m/s); days only in the reward and in the mission's clock,
 km only in the reset options (the user's edge). In the manner of gymnax's
-``step_env(key, state, action, params)``: a frozen :class:`Task` holds the
-parameters, a :class:`TaskState` the mutable state, and module functions move it:
+``step_env(key, state, action, params)``: a frozen `Task` holds the
+parameters, a `TaskState` the mutable state, and module functions move it:
 
-* :func:`start`: draw (or pin) new missions;
-* :func:`step`: burn at perigee (maybe), relocate the orbit on the universal curves,
+* `start`: draw (or pin) new missions;
+* `step`: burn at perigee (maybe), relocate the orbit on the universal curves,
   update the drag rates, coast K revolutions, and reward;
-* :func:`observe`: the scaled observation of a state;
-* :func:`decode`: the state a planner recovers from an observation;
-* :func:`lookahead`: burn now, then coast for a number of steps in one jump (the value
+* `observe`: the scaled observation of a state;
+* `decode`: the state a planner recovers from an observation;
+* `lookahead`: burn now, then coast for a number of steps in one jump (the value
   of never burning again: the greedy look-ahead's score, the shaping's potential, the
   DP's satellites that outlive the mission).
 
-Every consumer calls these: the single env (:mod:`orbit_env.envs.orbit_raising`)
-on a state of Python floats, the vector env (:mod:`orbit_env.envs.vector`) on a
+Every consumer calls these: the single env (`orbit_env.envs.orbit_raising`)
+on a state of Python floats, the vector env (`orbit_env.envs.vector`) on a
 state of arrays of shape (num_envs,), and the DP, the hand-coded policies and the
-reward shaping in :mod:`orbit_env.agents` on arrays of planned or decoded states.
+reward shaping in `orbit_env.agents` on arrays of planned or decoded states.
 Nothing else composes burn, coast and reward.
 
-The dynamics are the paper's universal curves (:mod:`orbit_env.decay.curves`): K
+The dynamics are the paper's universal curves (`orbit_env.decay.curves`): K
 revolutions move the universal variable nu by K g c s (Eq. 4.1), and the time is the
 drop of W = Int P dnu over g c s. A perigee burn keeps the perigee and raises the
-apogee (exact vis-viva, :mod:`orbit_env.physics.orbit`) and spends mass by the
+apogee (exact vis-viva, `orbit_env.physics.orbit`) and spends mass by the
 rocket equation, which raises c = c_x F / m.
 """
 
@@ -97,7 +97,7 @@ OBS_INDEX = {name: i for i, name in enumerate(OBS_NAMES)}
 OBS_LOW = np.zeros(len(OBS_NAMES), dtype=np.float32)
 OBS_HIGH = np.array([1.2, 5.0, MAX_DV_CAPACITY_M_S / DV_SCALE_M_S, 1.0, 1.0, 1.0, 1.0], dtype=np.float32)
 
-#: Reset options that pin the satellite (names of :class:`OrbitRaisingConfig` fields).
+#: Reset options that pin the satellite (names of `OrbitRaisingConfig` fields).
 SATELLITE_OPTIONS = ("drag_coefficient", "area_m2", "dry_mass_kg", "propellant_mass_kg", "isp_s")
 #: Reset options that pin the orbit and the atmosphere.
 ORBIT_OPTIONS = ("perigee_km", "apogee_km", "density_scale", "density_phase_rad")
@@ -155,7 +155,7 @@ class Task:
 
     @property
     def observation_space(self) -> spaces.Box:
-        """The observation space, the same in every variant (see :class:`OrbitRaisingEnv`)."""
+        """The observation space, the same in every variant (see `OrbitRaisingEnv`)."""
         return spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
 
     @property
@@ -214,7 +214,7 @@ class Task:
 
 
 class TaskView:
-    """The task's parts as attributes of an environment that holds a :class:`Task` as ``self.task``."""
+    """The task's parts as attributes of an environment that holds a `Task` as ``self.task``."""
 
     task: Task
 
@@ -238,7 +238,7 @@ class TaskView:
 # The state: Python floats for one satellite, rows of one array for many.
 # ---------------------------------------------------------------------------------
 
-#: The fields of a :class:`TaskState`, in the order of a :class:`BatchState`'s rows.
+#: The fields of a `TaskState`, in the order of a `BatchState`'s rows.
 STATE_FIELDS = (
     "label",  # mu, the universal curve the orbit decays along
     "tau",  # ln(1 + nu / NU_REF), the position along it
@@ -261,7 +261,7 @@ STATE_FIELDS = (
     "time_days",  # mission time [days]
     "steps",  # steps taken (whole numbers, exact in float64)
 )
-#: Rows below the fields in a :class:`BatchState`: each orbit's cell of the curves' table B
+#: Rows below the fields in a `BatchState`: each orbit's cell of the curves' table B
 #: (``UniversalCurves.locate_segments``), kept between steps so a coast needs no gather.
 SEGMENT_ROWS = 7
 #: A cell index no orbit is in: the next coast makes the orbit's cell afresh.
@@ -269,10 +269,10 @@ STALE_SEGMENT = -np.inf
 
 
 class TaskState:
-    """The state of one satellite: every field of :data:`STATE_FIELDS` a Python float.
+    """The state of one satellite: every field of `STATE_FIELDS` a Python float.
 
     The single environment steps one of these; the task functions read and assign
-    its attributes exactly as they do a :class:`BatchState`'s.
+    its attributes exactly as they do a `BatchState`'s.
     """
 
     # point: the CurvePoint of (label, tau, period_s, nu), kept by the task functions that move the
@@ -355,7 +355,7 @@ class BatchState:
 
 
 class SatelliteRows:
-    """Some satellites of a :class:`BatchState`, in place: reading a field gathers it, assigning scatters it.
+    """Some satellites of a `BatchState`, in place: reading a field gathers it, assigning scatters it.
 
     For the few satellites that burn in a step of thousands: the task functions run
     on them as on a batch, and only the fields they touch are gathered and written.
@@ -464,7 +464,7 @@ def period_gain_days_per_m_s_per_step(revolutions_per_step: float) -> float:
 def density_scale_at(
     base_scale: ArrayLike, amplitude: float, period_days: float, phase_rad: ArrayLike, time_days: ArrayLike
 ) -> FloatArray:
-    """Density scale s(t) = s0 exp(A sin(2 pi t / T + phi)) of :class:`DensityConfig`."""
+    """Density scale s(t) = s0 exp(A sin(2 pi t / T + phi)) of `DensityConfig`."""
     return np.asarray(base_scale) * np.exp(amplitude * np.sin(TWO_PI * np.asarray(time_days) / period_days + phase_rad))
 
 
@@ -477,7 +477,7 @@ def observation(
     apogee_drop_m: ArrayLike,
     perigee_drop_m: ArrayLike,
 ) -> tuple[Any, ...]:
-    """The seven scaled observation components (see :class:`OrbitRaisingEnv`), float64.
+    """The seven scaled observation components (see `OrbitRaisingEnv`), float64.
 
     Plain arithmetic only, so that it costs nothing on floats and broadcasts on arrays.
     """
@@ -585,9 +585,9 @@ def start(
     Args:
         task: The task.
         rng: The generator to draw from (the env's ``np_random``).
-        size: None for one satellite (a :class:`TaskState` of floats), else the
-            number of satellites (a :class:`BatchState`).
-        options: Reset options (:data:`RESET_OPTIONS`), numbers or arrays of shape (size,).
+        size: None for one satellite (a `TaskState` of floats), else the
+            number of satellites (a `BatchState`).
+        options: Reset options (`RESET_OPTIONS`), numbers or arrays of shape (size,).
 
     Raises:
         ValueError: an unknown or invalid option.
@@ -634,8 +634,8 @@ def states_at_orbits(
 
     The satellite is the config's with ``dv_left_m_s`` of delta-v left (its mass by
     the rocket equation), ``steps`` taken, the density at the nominal scale (phase 0,
-    time 0): what the DP, the policies and :func:`decode` plan on. The orbits are
-    located on the curves (:func:`place`).
+    time 0): what the DP, the policies and `decode` plan on. The orbits are
+    located on the curves (`place`).
     """
     perigee_m, apogee_m, dv_left_m_s, steps = np.broadcast_arrays(
         *(np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in (perigee_m, apogee_m, dv_left_m_s, steps))
@@ -648,7 +648,7 @@ def states_at_orbits(
 def states_on_curves(
     task: Task, label: ArrayLike, tau: ArrayLike, dv_left_m_s: ArrayLike, steps: ArrayLike
 ) -> BatchState:
-    """:func:`states_at_orbits` at curve coordinates (label, tau) instead of heights (the DP's grid)."""
+    """`states_at_orbits` at curve coordinates (label, tau) instead of heights (the DP's grid)."""
     label, tau, dv_left_m_s, steps = np.broadcast_arrays(
         *(np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in (label, tau, dv_left_m_s, steps))
     )
@@ -737,7 +737,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
     """Fire at perigee where asked and able: spend the mass, relocate the orbit; return the burns made [m/s].
 
     A request is cut to the propellant on board and to the 4000 km apogee cap of the
-    curves (:func:`perigee_burn`); an orbit whose burn comes to 0 is left untouched.
+    curves (`perigee_burn`); an orbit whose burn comes to 0 is left untouched.
     """
     if isinstance(state, TaskState):
         if not (requested_dv_m_s > 0.0 and state.dv_left_m_s > 0.0):
@@ -772,7 +772,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
 
 
 class StepResult(NamedTuple):
-    """What :func:`step` returns besides the updated state (floats or arrays)."""
+    """What `step` returns besides the updated state (floats or arrays)."""
 
     reward: Any  # days in orbit during the step minus the propellant's cost [days]
     terminated: Any  # re-entered (perigee at 100 km)
@@ -818,7 +818,7 @@ def step(task: Task, state: AnyState, requested_dv_m_s: Any) -> StepResult:
     Args:
         task: The task.
         state: One satellite's state (floats) or a batch's (arrays); updated in place.
-        requested_dv_m_s: The burn asked for [m/s] (:meth:`Task.requested_dv`), a
+        requested_dv_m_s: The burn asked for [m/s] (`Task.requested_dv`), a
             number or an array of the batch's shape.
 
     Returns:
@@ -883,7 +883,7 @@ def decode(task: Task, observation: Any) -> BatchState:
     The orbit from the observed heights (located on the curves), the mass from the
     delta-v left and the config's satellite (rocket equation), the steps taken from
     the mission clock, and the nominal density of ``task`` (see
-    :attr:`Task.planning`). Heights are clipped into the curves' domain.
+    `Task.planning`). Heights are clipped into the curves' domain.
 
     Raises:
         ValueError: an observation of another shape, or not finite.

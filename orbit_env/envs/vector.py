@@ -1,7 +1,7 @@
 """The orbit-raising environment batched over many satellites: the task model on arrays.
 
-The same functions of :mod:`orbit_env.envs.task` as the single environment, called
-on a :class:`~orbit_env.envs.task.BatchState` of shape (num_envs,): one call of the
+The same functions of `orbit_env.envs.task` as the single environment, called
+on a `BatchState` of shape (num_envs,): one call of the
 universal curves moves every satellite. The vector environment owns truncation
 (``horizon_steps``) and restarts finished satellites as Gymnasium 1.x's
 ``autoreset_mode`` says:
@@ -13,7 +13,7 @@ universal curves moves every satellite. The vector environment owns truncation
 * ``AutoresetMode.SAME_STEP``: the step that ends an episode returns the first
   observation of the new one; ``info["final_obs"]`` and ``info["final_info"]`` hold
   the last observation and info of the old (the convention of Stable-Baselines3,
-  see :mod:`orbit_env.envs.sb3`).
+  see `orbit_env.envs.sb3`).
 * ``AutoresetMode.DISABLED``: no restarts; reset finished satellites with
   ``reset(options={"reset_mask": mask})`` before stepping them again.
 """
@@ -41,7 +41,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     """``num_envs`` independent orbit-raising missions stepped together with numpy.
 
     Observation, action, reward and episode end are those of
-    :class:`orbit_env.envs.orbit_raising.OrbitRaisingEnv` (read its docstring),
+    `orbit_env.envs.orbit_raising.OrbitRaisingEnv` (read its docstring),
     batched: observations (num_envs, 7) float32, rewards float64, actions of shape
     (num_envs,) (discrete) or (num_envs, 1) (continuous). Truncation after
     ``config.horizon_steps`` steps. Finished missions restart as ``autoreset_mode``
@@ -118,7 +118,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
 
     @property
     def state(self) -> dict[str, FloatArray]:
-        """The simulator state of every satellite (copies), as :attr:`OrbitRaisingEnv.state`."""
+        """The simulator state of every satellite (copies), as `OrbitRaisingEnv.state`."""
         s = self._state
         return {
             name: getattr(s, name).copy()
@@ -127,7 +127,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
 
     @property
     def task_state(self) -> BatchState:
-        """The task model's state of every satellite (:class:`orbit_env.envs.task.BatchState`; live, not a copy)."""
+        """The task model's state of every satellite (`orbit_env.envs.task.BatchState`; live, not a copy)."""
         return self._state
 
     def reset(

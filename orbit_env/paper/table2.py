@@ -9,7 +9,7 @@ mean of the ratios).
 Most of the remaining deviation is the authors' numerical method, not the physics:
 they integrated Eq. (3.12) by Euler's method in steps of 5 km in p (10 km once the
 apogee is above 700 km), which overestimates nu where the density scale height
-is short. :func:`paper_scheme_nu` repeats that scheme on our averaged equations;
+is short. `paper_scheme_nu` repeats that scheme on our averaged equations;
 it reproduces Table II to a median of 1.9% (90th percentile 4.9%).
 
 A cell is flagged as a likely misprint when its log error differs by more than

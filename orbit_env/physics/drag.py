@@ -29,11 +29,11 @@ pure shear ``1 / (S sqrt(pi))`` (about 0.08); the wake side gives ~0.
 
 A convex body has no panel shading another, so its drag area is the sum of its
 panels' ``C_D A``. Integrating the panel formula over a sphere gives Sentman's
-closed form for a sphere (:func:`sphere_drag_coefficient`, on the area pi r^2).
+closed form for a sphere (`sphere_drag_coefficient`, on the area pi r^2).
 A convex body tumbling at random sees every surface element at a uniformly
 distributed gamma, so its mean drag area is that of a sphere of the same surface:
 ``C_D,sphere * surface / 4``, the surface / 4 being its mean projected area
-(Cauchy's theorem) (:func:`tumbling_drag_area_m2`).
+(Cauchy's theorem) (`tumbling_drag_area_m2`).
 
 Sources: L. H. Sentman, "Free molecule flow theory and its application to the
 determination of aerodynamic forces", Lockheed LMSC-448514 (1961); E. Doornbos,

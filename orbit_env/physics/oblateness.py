@@ -71,7 +71,7 @@ def perigee_rate_rad_per_rev(p_m: ArrayLike, inclination_rad: ArrayLike) -> Floa
         inclination_rad: Inclination [rad], from 0 to pi.
 
     Raises:
-        ValueError: as :func:`node_rate_rad_per_rev`.
+        ValueError: as `node_rate_rad_per_rev`.
     """
     p = _check_p(p_m)
     cos_i = np.cos(_check_inclination(inclination_rad))
@@ -82,7 +82,7 @@ def revolutions_per_day(p_m: ArrayLike, e: ArrayLike) -> FloatArray:
     """Keplerian periods in a day for the orbit (p, e).
 
     Raises:
-        ValueError: ``p_m`` as in :func:`node_rate_rad_per_rev`, or e outside [0, 1).
+        ValueError: ``p_m`` as in `node_rate_rad_per_rev`, or e outside [0, 1).
     """
     p = _check_p(p_m)
     ecc = check_array(e, "e", low=0.0, high=1.0, high_inclusive=False, why="an ellipse")
@@ -93,7 +93,7 @@ def node_rate_rad_per_day(p_m: ArrayLike, e: ArrayLike, inclination_rad: ArrayLi
     """Secular drift of the ascending node per day [rad/day]: Eq. (5.5) times revolutions a day.
 
     Raises:
-        ValueError: as :func:`node_rate_rad_per_rev` and :func:`revolutions_per_day`.
+        ValueError: as `node_rate_rad_per_rev` and `revolutions_per_day`.
     """
     return node_rate_rad_per_rev(p_m, inclination_rad) * revolutions_per_day(p_m, e)
 
@@ -102,6 +102,6 @@ def perigee_rate_rad_per_day(p_m: ArrayLike, e: ArrayLike, inclination_rad: Arra
     """Secular drift of the argument of perigee per day [rad/day]: Eq. (5.6) times revolutions a day.
 
     Raises:
-        ValueError: as :func:`perigee_rate_rad_per_rev` and :func:`revolutions_per_day`.
+        ValueError: as `perigee_rate_rad_per_rev` and `revolutions_per_day`.
     """
     return perigee_rate_rad_per_rev(p_m, inclination_rad) * revolutions_per_day(p_m, e)

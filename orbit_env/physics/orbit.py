@@ -24,7 +24,7 @@ MAX_APOGEE_M = 50_000e3
 def _check_heights(
     perigee: ArrayLike, apogee: ArrayLike, names: tuple[str, str], unit: str, unit_m: float
 ) -> tuple[FloatArray, FloatArray]:
-    """The checks of :func:`validate_heights`, in the caller's unit (``unit_m`` metres)."""
+    """The checks of `validate_heights`, in the caller's unit (``unit_m`` metres)."""
     hp, ha = np.broadcast_arrays(np.asarray(perigee), np.asarray(apogee))
     hp = check_array(
         hp,
@@ -51,12 +51,12 @@ def validate_heights(perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatAr
 
 
 def validate_heights_km(perigee_km: ArrayLike, apogee_km: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """:func:`validate_heights` for heights given in km; returns them in metres.
+    """`validate_heights` for heights given in km; returns them in metres.
 
     The check happens in km, so a message says ``perigee_km=50``, as the caller typed it.
 
     Raises:
-        ValueError: as :func:`validate_heights`, naming ``perigee_km``/``apogee_km``.
+        ValueError: as `validate_heights`, naming ``perigee_km``/``apogee_km``.
     """
     hp, ha = _check_heights(perigee_km, apogee_km, ("perigee_km", "apogee_km"), "km", 1e3)
     return hp * 1e3, ha * 1e3
@@ -100,7 +100,7 @@ def apogee_after_perigee_burn_m(perigee_m: ArrayLike, apogee_m: ArrayLike, dv_m_
 
     A prograde burn (``dv_m_s >= 0``) at perigee keeps the perigee and raises the
     apogee; the result is clamped so that round-off never lowers it. A burn at or
-    beyond escape (see :func:`escape_dv_m_s`) returns 2e300 m: unbounded.
+    beyond escape (see `escape_dv_m_s`) returns 2e300 m: unbounded.
     """
     rp = np.add(perigee_m, EARTH_RADIUS_M)
     ra = np.add(apogee_m, EARTH_RADIUS_M)

@@ -1,10 +1,10 @@
 """Upper-atmosphere density models, one module per model.
 
-* :mod:`~orbit_env.physics.atmosphere.base`: the :class:`Atmosphere` protocol and
-  :func:`as_atmosphere` (a user's function of altitude).
-* :mod:`~orbit_env.physics.atmosphere.paper`: the paper's law, Eq. (1.1) with Table 1.
-* :mod:`~orbit_env.physics.atmosphere.exponential`: an isothermal exponential law.
-* :mod:`~orbit_env.physics.atmosphere.msis`: NRLMSIS 2.1 through ``pymsis``, orbit-averaged
+* `base`: the `Atmosphere` protocol and
+  `as_atmosphere` (a user's function of altitude).
+* `paper`: the paper's law, Eq. (1.1) with Table 1.
+* `exponential`: an isothermal exponential law.
+* `msis`: NRLMSIS 2.1 through ``pymsis``, orbit-averaged
   (imported on use: it needs the ``msis`` extra).
 """
 

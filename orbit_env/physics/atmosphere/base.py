@@ -2,7 +2,7 @@
 
 Every model is a small frozen dataclass with one vectorized method,
 ``density_kg_m3(altitude_m)``. The decay core accepts any object with that method,
-or any plain vectorized function of altitude (see :func:`as_atmosphere`), so a user
+or any plain vectorized function of altitude (see `as_atmosphere`), so a user
 can plug in a density profile of their own.
 """
 
@@ -37,7 +37,7 @@ class FunctionAtmosphere:
 
 
 def as_atmosphere(model: Atmosphere | Callable[[NDArray[np.float64]], ArrayLike] | None) -> Atmosphere:
-    """Return ``model`` as an :class:`Atmosphere` (``None`` gives the paper's law)."""
+    """Return ``model`` as an `Atmosphere` (``None`` gives the paper's law)."""
     if model is None:
         from orbit_env.physics.atmosphere.paper import PaperAtmosphere
 

@@ -24,7 +24,7 @@ SCALE_HEIGHT_RANGE_M = (1e3, 500e3, "the air's scale height runs from 6 km near 
 class ExponentialAtmosphere:
     """Isothermal law rho0 * exp(-(h - h0) / H), for comparison with other tools.
 
-    The defaults are :data:`ORBITAL_LAW`, a law for orbital heights.
+    The defaults are `ORBITAL_LAW`, a law for orbital heights.
 
     Args:
         rho0_kg_m3: Density at the reference altitude.

@@ -3,7 +3,7 @@
 The decay core needs density against altitude only (``density_kg_m3(altitude_m)``,
 altitude above the package's spherical Earth of radius ``EARTH_RADIUS_M``). NRLMSIS
 gives density at a point: latitude, local solar time, day of year, altitude and the
-solar and geomagnetic indices. :class:`MsisAtmosphere` averages it, once per solar
+solar and geomagnetic indices. `MsisAtmosphere` averages it, once per solar
 condition, into a table of log-density on an altitude grid, and interpolates that.
 
 How the average is taken, and why:
@@ -40,7 +40,7 @@ the model's own uncertainty (~15%).
 
 The indices are held fixed: F10.7 of the day before (``f107_sfu``), its 81-day
 centred mean (``f107a_sfu``) and the daily Ap (``ap``), all seven Ap slots equal.
-For activity that changes over a lifetime see :mod:`orbit_env.decay.solar`.
+For activity that changes over a lifetime see `orbit_env.decay.solar`.
 
 Table: ``ALTITUDE_GRID_M`` (40-6000 km, 2 km steps where the scale height is short;
 below 40 km the 40 km value is held: no decay computed here reaches that low);
@@ -49,7 +49,7 @@ relative error is below 1e-3 from 150 to 1000 km and below 4e-3 elsewhere,
 measured in ``tests/test_msis.py``),
 and extrapolated above the grid with its top slope. Building a table costs about
 0.3 s (~600 000 NRLMSIS points) and is cached per condition, so the universal
-curves of :mod:`orbit_env.decay.curves` can be built and cached per profile too.
+curves of `orbit_env.decay.curves` can be built and cached per profile too.
 
 Nothing is downloaded: all indices are given explicitly to ``pymsis``.
 """
@@ -233,7 +233,7 @@ def mean_density_over_days_kg_m3(
 
 @lru_cache(maxsize=256)
 def _cached_log_density_table(*conditions: float | None) -> FloatArray:
-    """:func:`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""
+    """`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""
     description = cache.describe(conditions)
     table = cache.load("msis", description)
     if table is None:
@@ -270,7 +270,7 @@ def interpolate_log_density(altitude_m: ArrayLike, log_rho: FloatArray) -> Float
 class MsisAtmosphere:
     """NRLMSIS 2.1 averaged over an orbit, at fixed solar and geomagnetic activity.
 
-    Frozen and hashable: :func:`orbit_env.decay.curves.universal_curves` caches the
+    Frozen and hashable: `orbit_env.decay.curves.universal_curves` caches the
     curves per instance, and the density table is cached per condition.
 
     Args:

@@ -6,8 +6,8 @@ The law::
 
 in three bands (100-150, 150-250, 250-900 km), the top band extended above 900 km
 as the paper does (section 3). The paper does not print rho1, the density at
-100 km; :data:`RHO100_CALIBRATED_KG_M3` is its least-squares fit to Table II
-(:func:`orbit_env.paper.table2.calibrate_rho100`; docs: the paper's reproduction).
+100 km; `RHO100_CALIBRATED_KG_M3` is its least-squares fit to Table II
+(`orbit_env.paper.table2.calibrate_rho100`; docs: the paper's reproduction).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from orbit_env.checks import check_number
 
 #: rho1 of Eq. (1.1): least squares in log(nu) over all 351 cells of Table II,
-#: made by :func:`orbit_env.paper.table2.calibrate_rho100` (median of the log residuals
+#: made by `orbit_env.paper.table2.calibrate_rho100` (median of the log residuals
 #: and their mean agree to 0.5%).
 RHO100_CALIBRATED_KG_M3 = 1.633e-6
 
