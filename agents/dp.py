@@ -59,25 +59,22 @@ days where the successor outlives the mission.
 Grid refinement on the 200 evaluation episodes of ``orbit-env evaluate``
 (seed 12345; default config, density scale 1): "value" is the mean of
 `DPSolution.value` at the start states, "realized" the mean return of
-`DPPolicy` in the env, |d| = |value - realized| per episode, "greedy
+`DPPolicy` in the env, d = value - realized per episode, "greedy
 ahead" the worst episode's lead of the greedy look-ahead over the DP policy.
 Solve times on one core of a 2-core machine with a PPO training on the other;
 "memory" is the solving process' peak.
 
-=========  =========  =========  ======  =======  ========  ========  =========  ========
-grid       states     solve [s]  memory  value    realized  mean |d|  worst |d|  greedy
-                                 [GB]                                            ahead
-=========  =========  =========  ======  =======  ========  ========  =========  ========
-32, 1, 1     400 384        3.2    0.36  265.287   264.020      1.29       25.6      22.2
-64, 1, 1     800 768        6.3    0.61  265.258   264.719      0.57       13.0      11.5
-96, 1, 1   1 201 152        9.1    0.84  265.233   264.998      0.26        5.5       3.6
-128, 1, 1  1 601 536       12.6    1.08  265.218   265.077      0.16        2.9       2.6
-160, 1, 1  2 001 920       16.3    1.31  265.210   265.112      0.13        2.7       1.2
-192, 1, 1  2 402 304       19.6    1.50  265.206   265.133      0.10        1.9       1.1
-256, 1, 1  3 203 072       26.4    1.96  265.196   265.154      0.07        1.8       1.1
-192, 1, 2  4 654 464       38.7    2.76  265.206   265.133      0.10        1.9       1.1
-192, 2, 1  4 651 008       41.9    2.83  265.203   265.141      0.09        1.5       0.8
-=========  =========  =========  ======  =======  ========  ========  =========  ========
+| grid | states | solve [s] | memory [GB] | value | realized | mean abs(d) | worst abs(d) | greedy ahead |
+|---|---|---|---|---|---|---|---|---|
+| 32, 1, 1 | 400 384 | 3.2 | 0.36 | 265.287 | 264.020 | 1.29 | 25.6 | 22.2 |
+| 64, 1, 1 | 800 768 | 6.3 | 0.61 | 265.258 | 264.719 | 0.57 | 13.0 | 11.5 |
+| 96, 1, 1 | 1 201 152 | 9.1 | 0.84 | 265.233 | 264.998 | 0.26 | 5.5 | 3.6 |
+| 128, 1, 1 | 1 601 536 | 12.6 | 1.08 | 265.218 | 265.077 | 0.16 | 2.9 | 2.6 |
+| 160, 1, 1 | 2 001 920 | 16.3 | 1.31 | 265.210 | 265.112 | 0.13 | 2.7 | 1.2 |
+| 192, 1, 1 | 2 402 304 | 19.6 | 1.50 | 265.206 | 265.133 | 0.10 | 1.9 | 1.1 |
+| 256, 1, 1 | 3 203 072 | 26.4 | 1.96 | 265.196 | 265.154 | 0.07 | 1.8 | 1.1 |
+| 192, 1, 2 | 4 654 464 | 38.7 | 2.76 | 265.206 | 265.133 | 0.10 | 1.9 | 1.1 |
+| 192, 2, 1 | 4 651 008 | 41.9 | 2.83 | 265.203 | 265.141 | 0.09 | 1.5 | 0.8 |
 
 The value moves by less than 0.04% from 32 labels on, the realized return
 converges to it (0.03% below at 192 labels). Halving the delta-v spacing

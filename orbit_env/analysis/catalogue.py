@@ -2,17 +2,16 @@
 
 Input columns (a header row; names case-insensitive, any order, extra columns ignored):
 
-=========================  ========================================================
-``perigee_km``             perigee height (required)
-``apogee_km``              apogee height (required)
-``mass_kg``, ``area_m2``   mass and reference area (together), or
-``mass_per_area_kg_m2``    transverse load G/F, or
-``drag_parameter_m2_kg``   c = c_x A / m directly; a missing value takes the CLI's
-                           satellite (``--mass``/``--area``/``--mass-per-area``/``--cx``)
-``cx``                     drag coefficient (default: ``--cx``)
-``inclination_deg``        inclination (default: ``--inclination``)
-``name`` or ``id``         copied to the output
-=========================  ========================================================
+| column | meaning |
+|---|---|
+| ``perigee_km`` | perigee height (required) |
+| ``apogee_km`` | apogee height (required) |
+| ``mass_kg``, ``area_m2`` | mass and reference area (together), or |
+| ``mass_per_area_kg_m2`` | transverse load G/F, or |
+| ``drag_parameter_m2_kg`` | c = c_x A / m directly; a missing value: the CLI's satellite (``--mass``, ``--cx``, ...) |
+| ``cx`` | drag coefficient (default: ``--cx``) |
+| ``inclination_deg`` | inclination (default: ``--inclination``) |
+| ``name`` or ``id`` | copied to the output |
 
 Output columns: ``name``/``id`` (if given), ``perigee_km``, ``apogee_km``,
 ``inclination_deg``, ``drag_parameter_m2_kg``, ``days``, ``years``, with a rule
