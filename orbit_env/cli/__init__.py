@@ -50,7 +50,3 @@ def main(argv: Sequence[str] | None = None) -> int:
         message = text.splitlines()[0] if text else type(error).__name__
         print(f"{PROG}: error: {message}", file=sys.stderr)
         return 2
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
