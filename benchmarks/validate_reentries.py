@@ -29,58 +29,15 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import numpy as np
-
 from orbit_env.analysis.lifetime import Satellite, lifetime
-from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
+from orbit_env.analysis.shapes import Shape, drag_at_start, flown_nose_first, sphere
 from orbit_env.decay.solar import TableActivity, read_solar_csv, unix_days
-from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples, require_pymsis
-from orbit_env.physics.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
 
 SOLAR_CSV = Path(__file__).resolve().parent.parent / "docs" / "data" / "solar_daily_1995_2018.csv"
 #: Heights published above the equatorial radius (6378.137 km) are 7.137 km higher above our 6371 km sphere.
 EQUATORIAL_OFFSET_KM = 7.137
 #: The drag coefficient chosen first, on the frontal (cross-section) area.
 FIRST_CHOICE_CX = 2.2
-#: Energy accommodation of the drag model (Sentman's diffuse, fully accommodated re-emission).
-ACCOMMODATION = 1.0
-
-
-@dataclass(frozen=True)
-class Shape:
-    """What the air sees: a sphere, or flat panels at fixed incidence (the satellite flown in a fixed attitude).
-
-    Attributes:
-        reference_area_m2: The frontal area the drag coefficient refers to.
-        sphere: True for a sphere of that cross-section (the panels are then unused).
-        panel_areas_m2: Panel areas (one side each; a thin wing is two panels).
-        panel_cos_incidence: Cosine between each panel's outward normal and the direction the air comes from.
-    """
-
-    reference_area_m2: float
-    sphere: bool = False
-    panel_areas_m2: tuple[float, ...] = ()
-    panel_cos_incidence: tuple[float, ...] = ()
-
-    def drag_coefficient(self, s: np.ndarray, wall_to_gas: np.ndarray) -> np.ndarray:
-        """Drag coefficient on the reference area for speed ratios ``s`` and T_w / T (arrays alike)."""
-        if self.sphere:
-            return sphere_drag_coefficient(s, wall_to_gas, ACCOMMODATION)
-        areas = np.array(self.panel_areas_m2)
-        gamma = np.array(self.panel_cos_incidence)
-        return panel_drag_area_m2(areas, gamma, s, wall_to_gas, ACCOMMODATION) / self.reference_area_m2
-
-
-def sphere(diameter_m: float) -> Shape:
-    """A sphere of this diameter."""
-    return Shape(math.pi * diameter_m**2 / 4.0, sphere=True)
-
-
-def flown_nose_first(front_m2: float, parallel_m2: float) -> Shape:
-    """A prism flown along its axis: a front face, the same area in the wake, and flow-parallel surfaces."""
-    return Shape(front_m2, panel_areas_m2=(front_m2, front_m2, parallel_m2), panel_cos_incidence=(1.0, -1.0, 0.0))
-
-
 # GRACE panels (area m^2, normal) of the GRACE-FO Level-1 handbook's Table 5 (GRACE-FO kept the GRACE body),
 # x along-track: front + boom face the flow, rear + boom in the wake, the rest (normals in the y-z plane) parallel.
 GRACE_FRONT_M2 = 0.9551567 + 0.0461901
@@ -156,47 +113,22 @@ def observed_days(case: Case) -> float:
     return unix_days(case.reentry) - unix_days(case.start)
 
 
-def start_gas(case: Case, activity: TableActivity) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-    """NRLMSIS at the start: density [kg/m^3], temperature [K] and mean molecular mass [kg] over the orbit.
-
-    Samples: the orbit's latitudes and local times
-    (:func:`orbit_env.physics.atmosphere.msis.orbit_samples`) at the mean initial height,
-    on the start date with its indices. Also returns the speed relative to the co-rotating air [m/s].
-    """
-    msis = require_pymsis()
-    height_m = (0.5 * (case.perigee_km + case.apogee_km) + EQUATORIAL_OFFSET_KM) * 1e3
-    lat, local_time = orbit_samples(case.inclination_deg, case.node_local_time_h)
-    start = np.datetime64(case.start, "s")
-    ut_h = (start - start.astype("datetime64[D]")).astype(np.int64) / 3600.0
-    lon = np.mod((local_time - ut_h) * 15.0, 360.0)
-    f107, f107a, ap = (float(x) for x in activity.indices(unix_days(case.start)))
-    out = msis.calculate(
-        np.full(lat.size, start),
-        lon,
-        lat,
-        geodetic_altitude_m(height_m, lat) / 1e3,
-        f107s=np.full(lat.size, f107),
-        f107as=np.full(lat.size, f107a),
-        aps=np.full((lat.size, 7), ap),
-        version=2.1,
-    )
-    rho = out[:, 0]
-    number_m3 = np.nansum(out[:, 1:10], axis=1)
-    radius_m = EARTH_RADIUS_M + height_m
-    # Mean speed against the co-rotating air: the air's eastward speed projected on the track averages omega r cos i.
-    speed = math.sqrt(MU_EARTH_M3_S2 / radius_m) - EARTH_ROTATION_RAD_S * radius_m * math.cos(
-        math.radians(case.inclination_deg)
-    )
-    return rho, out[:, 10], rho / number_m3, speed
-
-
 def drag_coefficient(case: Case, activity: TableActivity) -> tuple[float, float, float]:
-    """The model's drag coefficient on the reference area, density-weighted over the orbit; also mean S and T [K]."""
-    rho, temperature, mass, speed = start_gas(case, activity)
-    s = speed_ratio(speed, temperature, mass)
-    cd = case.shape.drag_coefficient(s, WALL_TEMPERATURE_K / temperature)
-    weight = rho / rho.sum()
-    return float(np.sum(weight * cd)), float(np.sum(weight * s)), float(np.sum(weight * temperature))
+    """The model's drag coefficient on the reference area, density-weighted over the orbit; also mean S and T [K].
+
+    NRLMSIS at the start (the orbit's latitudes and local times at the mean initial height, on the
+    start date with its indices), against the co-rotating air: ``orbit_env.analysis.shapes.drag_at_start``.
+    """
+    height_m = (0.5 * (case.perigee_km + case.apogee_km) + EQUATORIAL_OFFSET_KM) * 1e3
+    gas = drag_at_start(
+        case.shape,
+        height_m,
+        case.inclination_deg,
+        tuple(float(x) for x in activity.indices(unix_days(case.start))),
+        case.start,
+        ascending_node_local_time_h=case.node_local_time_h,
+    )
+    return gas.drag_coefficient, gas.speed_ratio, gas.temperature_k
 
 
 def predict(case: Case, activity: TableActivity, cx: float, height_shift_km: float = 0.0) -> float:
