@@ -288,10 +288,6 @@ class TaskState:
             setattr(other, name, getattr(self, name))
         return other
 
-    def as_dict(self) -> dict[str, float]:
-        """The fields by name."""
-        return {name: float(getattr(self, name)) for name in STATE_FIELDS}
-
 
 class BatchState:
     """The states of many satellites: the rows of one (fields + segments, n) float64 array.
@@ -348,10 +344,6 @@ class BatchState:
     def copy(self) -> BatchState:
         """An independent copy."""
         return BatchState(self.data.copy())
-
-    def as_dict(self) -> dict[str, FloatArray]:
-        """The fields by name (copies)."""
-        return {name: self.__dict__[name].copy() for name in STATE_FIELDS}
 
 
 class SatelliteRows:
