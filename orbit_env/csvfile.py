@@ -59,6 +59,14 @@ class CsvTable:
                 raise ValueError(f"{self.source}: {what} needs a '{column}' column; its header has {found}")
 
 
+def cell_value(text: str) -> float | str:
+    """A cell as a float, or the text itself (which ``check_number`` then refuses by name)."""
+    try:
+        return float(text)
+    except ValueError:
+        return text if text else "(empty)"
+
+
 def read_csv(path: str | Path) -> CsvTable:
     """Read a CSV file with a header row (see the module docstring).
 

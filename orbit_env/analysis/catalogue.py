@@ -52,7 +52,7 @@ from orbit_env.analysis.lifetime import (
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
-from orbit_env.csvfile import read_csv
+from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.decay.curves import UniversalCurves
 
 FloatArray = NDArray[np.float64]
@@ -81,11 +81,7 @@ def _number(row: dict[str, str], key: str, **bounds: Any) -> float | None:
     text = row.get(key, "")
     if text == "":
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        value = text  # check_number refuses it, naming the column and the text
-    return check_number(value, key, **bounds)
+    return check_number(cell_value(text), key, **bounds)  # a text cell is refused, named with its column
 
 
 def _bounded(row: dict[str, str], key: str, unit: str, bounds: tuple[float, float, str]) -> float | None:

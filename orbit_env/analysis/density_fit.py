@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario
 from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
-from orbit_env.csvfile import read_csv
+from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import unix_days
 from orbit_env.physics.orbit import elements_from_heights, period_s
@@ -113,9 +113,9 @@ def read_observations(path: str | Path) -> Observations:
             if axis == "date":
                 days[i] = check_date(unix_days(text), "date", text=text)
             else:
-                days[i] = check_number(_float(text), "days", unit="days")
-            hp[i] = check_number(_float(row.cells["perigee_km"]), "perigee_km", unit="km")
-            ha[i] = check_number(_float(row.cells["apogee_km"]), "apogee_km", unit="km")
+                days[i] = check_number(cell_value(text), "days", unit="days")
+            hp[i] = check_number(cell_value(row.cells["perigee_km"]), "perigee_km", unit="km")
+            ha[i] = check_number(cell_value(row.cells["apogee_km"]), "apogee_km", unit="km")
         except ValueError as error:
             raise ValueError(f"{where}: {error}") from None
     for i in np.flatnonzero(np.diff(days) <= 0):
@@ -124,14 +124,6 @@ def read_observations(path: str | Path) -> Observations:
             "observations go in time order, one per time"
         )
     return Observations(days, hp, ha, source, axis, tuple(row.line for row in table.rows))
-
-
-def _float(text: str) -> float | str:
-    """A cell as a float, or the text itself (which check_number then refuses by name)."""
-    try:
-        return float(text)
-    except ValueError:
-        return text if text else "(empty)"
 
 
 def reentry_days(reentry: str | float, observations: Observations, name: str = "reentry") -> float:

@@ -36,7 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import InputError, check_array, check_number, format_number
-from orbit_env.csvfile import read_csv
+from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.physics.atmosphere.msis import AP_RANGE, F107_RANGE_SFU
 
 FloatArray = NDArray[np.float64]
@@ -208,11 +208,11 @@ def read_solar_csv(path: str | Path, default_ap: float = DEFAULT_AP) -> TableAct
                     f"date={cells['date']!r} is out of range; allowed: {SOLAR_TABLE_DATES[0]} to "
                     f"{SOLAR_TABLE_DATES[1]} (F10.7 is measured since 1947)"
                 )
-            f107[i] = check_number(_cell(cells["f107"]), "f107", unit="sfu")
+            f107[i] = check_number(cell_value(cells["f107"]), "f107", unit="sfu")
             if cells.get("f107a"):
-                f107a[i] = check_number(_cell(cells["f107a"]), "f107a", unit="sfu")
+                f107a[i] = check_number(cell_value(cells["f107a"]), "f107a", unit="sfu")
             if cells.get("ap"):
-                ap[i] = check_number(_cell(cells["ap"]), "ap")
+                ap[i] = check_number(cell_value(cells["ap"]), "ap")
         except ValueError as error:
             raise ValueError(f"{row.where(source)}: {error}") from None
     for i in np.flatnonzero(np.diff(days) <= 0):
@@ -224,14 +224,6 @@ def read_solar_csv(path: str | Path, default_ap: float = DEFAULT_AP) -> TableAct
     if missing.any():
         f107a[missing] = centred_mean(days, f107)[missing]
     return TableActivity(days, f107, f107a, ap, source=source)
-
-
-def _cell(text: str) -> float | str:
-    """A cell as a float, or the text itself (which check_number then refuses by name)."""
-    try:
-        return float(text)
-    except ValueError:
-        return text if text else "(empty)"
 
 
 def _cycle_shape(phase: FloatArray, peak_phase: float) -> FloatArray:
