@@ -645,7 +645,7 @@ def states_on_curves(
         *(np.atleast_1d(np.asarray(v, dtype=np.float64)) for v in (label, tau, dv_left_m_s, steps))
     )
     state = _satellite_states(task, dv_left_m_s, steps, label.size)
-    place_on_curves(state, label, tau)
+    place_on_curves(task, state, label, tau)
     return state
 
 
@@ -689,7 +689,7 @@ def place(task: Task, state: AnyState, perigee_m: Any, apogee_m: Any) -> None:
     observed decay of a step is never the locate-and-read-back round trip's
     interpolation error (``UniversalCurves.locate_heights``).
     """
-    curves = universal_curves()
+    curves = task.curves
     if isinstance(state, TaskState):
         point, state.perigee_m, state.apogee_m = curves.locate_heights(float(perigee_m), float(apogee_m))
     else:
@@ -702,12 +702,12 @@ def place(task: Task, state: AnyState, perigee_m: Any, apogee_m: Any) -> None:
         state.point = point
 
 
-def place_on_curves(state: BatchState, label: FloatArray, tau: FloatArray) -> None:
+def place_on_curves(task: Task, state: BatchState, label: FloatArray, tau: FloatArray) -> None:
     """Put orbits at curve coordinates (label, tau), with the heights and the mean period there (``at``).
 
     Their cells of the curves' table are marked stale, so the first coast makes them.
     """
-    perigee_m, apogee_m, period = universal_curves().at(label, tau)
+    perigee_m, apogee_m, period = task.curves.at(label, tau)
     point = CurvePoint(label, tau, period)
     state.label = label
     state.tau = tau
