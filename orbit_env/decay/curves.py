@@ -200,6 +200,83 @@ class _Grid:
         return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[i * self.ny + j].tolist()]
 
 
+def _spline_rows(x: FloatArray, y: FloatArray, counts: NDArray[np.intp], query: FloatArray) -> FloatArray:
+    """Cubic splines through the knots of each row, at the query points: scipy's ``CubicSpline`` in numpy.
+
+    The spline of each row is scipy's default, not-a-knot at both ends, built the
+    same way (first derivatives at the knots from one tridiagonal system, then the
+    Hermite cubic of each interval), so it agrees with ``CubicSpline`` to round-off
+    (``tests/test_curves.py`` compares them). The rows' systems are solved together
+    by the Thomas algorithm, a sweep over the knots vectorized over the rows: its
+    pivots stay nonzero for not-a-knot ends on increasing knots, where scipy's
+    banded solver pivots. Importing scipy.interpolate alone costs longer than the
+    whole table.
+
+    Args:
+        x: Knots (rows, n): each row's first ``counts`` entries, increasing (the rest ignored).
+        y: Values at the knots (k, rows, n): k functions per row.
+        counts: Knots per row, each at least 4.
+        query: Points (m,), clamped to each row's first and last knot.
+
+    Returns:
+        The splines at the query points (k, rows, m).
+    """
+    rows, size = x.shape
+    assert np.all(counts >= 4) and np.all(counts <= size), "a not-a-knot cubic needs four knots"
+    r = np.arange(rows)
+    last = np.asarray(counts) - 1
+    beyond = np.arange(size)[None, :] > last[:, None]
+    # Past a row's last knot: knots 1 m apart and the last value repeated, finite and ignored.
+    x = np.where(beyond, x[r, last][:, None] + (np.arange(size)[None, :] - last[:, None]), x)
+    y = np.where(beyond[None], y[:, r, last][..., None], y)
+    dx = np.diff(x, axis=-1)
+    slope = np.diff(y, axis=-1) / dx
+    lower, diag, upper = np.zeros((rows, size)), np.ones((rows, size)), np.zeros((rows, size))
+    rhs = np.zeros(y.shape)
+    # Inside: continuity of the second derivative (scipy's rows i = 1 .. n-2).
+    lower[:, 1:-1], diag[:, 1:-1], upper[:, 1:-1] = dx[:, 1:], 2.0 * (dx[:, :-1] + dx[:, 1:]), dx[:, :-1]
+    rhs[..., 1:-1] = 3.0 * (dx[:, 1:] * slope[..., :-1] + dx[:, :-1] * slope[..., 1:])
+    # Not-a-knot at the first knot ...
+    d = x[:, 2] - x[:, 0]
+    diag[:, 0], upper[:, 0] = dx[:, 1], d
+    rhs[..., 0] = ((dx[:, 0] + 2.0 * d) * dx[:, 1] * slope[..., 0] + dx[:, 0] ** 2 * slope[..., 1]) / d
+    # ... and at the last, with the rows past it an identity that the sweep leaves at zero.
+    d = x[r, last] - x[r, last - 2]
+    lower[r, last], diag[r, last], upper[r, last] = d, dx[r, last - 2], 0.0
+    dx_end, dx_before = dx[r, last - 1], dx[r, last - 2]
+    rhs[:, r, last] = (dx_end**2 * slope[:, r, last - 2] + (2.0 * d + dx_end) * dx_before * slope[:, r, last - 1]) / d
+    lower[beyond], diag[beyond], upper[beyond] = 0.0, 1.0, 0.0
+    rhs[:, beyond] = 0.0
+    # Thomas algorithm, knot after knot (columns made rows: contiguous slices).
+    lower, diag, upper, rhs = lower.T.copy(), diag.T.copy(), upper.T.copy(), rhs.transpose(2, 0, 1).copy()
+    for i in range(1, size):
+        w = lower[i] / diag[i - 1]
+        diag[i] -= w * upper[i - 1]
+        rhs[i] -= w * rhs[i - 1]
+    s = np.empty_like(rhs)
+    s[-1] = rhs[-1] / diag[-1]
+    for i in range(size - 2, -1, -1):
+        s[i] = (rhs[i] - upper[i] * s[i + 1]) / diag[i]
+    s = s.transpose(1, 2, 0)  # (k, rows, n): the first derivative at each knot
+    # The Hermite cubic on each interval, in powers of the distance from its left knot (scipy's PPoly).
+    t = (s[..., :-1] + s[..., 1:] - 2.0 * slope) / dx
+    c3, c2, c1, c0 = t / dx, (slope - s[..., :-1]) / dx - t, s[..., :-1], y[..., :-1]
+    interval = np.empty((rows, query.size), dtype=np.intp)
+    for row in range(rows):
+        n = last[row] + 1
+        interval[row] = np.clip(np.searchsorted(x[row, :n], query, side="right") - 1, 0, n - 2)
+    z = np.clip(query[None, :], x[:, :1], x[r, last][:, None]) - np.take_along_axis(x, interval, axis=1)
+    out = np.empty((y.shape[0], rows, query.size))
+    for m in range(y.shape[0]):
+        value = np.take_along_axis(c0[m], interval, axis=1)
+        power = z.copy()
+        for c in (c1, c2, c3):
+            value += np.take_along_axis(c[m], interval, axis=1) * power
+            power *= z
+        out[m] = value
+    return out
+
+
 def _heights(mu: FloatArray, b0: FloatArray, b1: FloatArray, q: FloatArray) -> tuple[FloatArray, ...]:
     """Table B's values (perigee height, ln e - mu, q) at labels mu into perigee and apogee heights [m] and q."""
     hp = np.maximum(b0, REENTRY_ALTITUDE_M)
@@ -359,11 +436,10 @@ class UniversalCurves:
         not columns: elongated orbits decay at an almost constant perigee, so the
         curves stand nearly vertical in (perigee, ln e) and cross rows cleanly.
         Along a row the values are smooth in perigee height: a cubic spline
-        through the crossings. Beyond the lowest curve (more nearly circular
-        orbits) the curves are translates of it: its values at the same height.
+        through the crossings (`_spline_rows`, all rows at once). Beyond the lowest
+        curve (more nearly circular orbits) the curves are translates of it: its
+        values at the same height.
         """
-        from scipy.interpolate import CubicSpline  # on use: half a second of start-up
-
         labels = self.labels
         y_grid = np.arange(labels[0], np.nanmax(y), _DY)
         hp_grid = np.arange(REENTRY_ALTITUDE_M, _HP_TOP_M, _DH_M)
@@ -373,21 +449,26 @@ class UniversalCurves:
             for row, values in enumerate((hp[j], tau)):
                 crossing[row, j] = np.interp(y_grid, y[j, valid], values[valid], left=np.nan, right=np.nan)
         lowest = np.isfinite(hp[0])
-        beyond = [np.interp(hp_grid, hp[0, lowest], v[lowest]) for v in (labels[0] - y[0], tau)]
-        table = np.empty((2, hp_grid.size, y_grid.size))
-        for m in range(y_grid.size):
-            valid = np.isfinite(crossing[0, :, m])
-            hp_m = crossing[0, valid, m][::-1]
-            assert np.all(np.diff(hp_m) > 0), "decay curves must not cross"
-            values = (labels[valid][::-1] - y_grid[m], crossing[1, valid, m][::-1])
-            inside = hp_grid <= hp_m[-1]
-            for row in range(2):
-                if hp_m.size >= 4:
-                    table[row, inside, m] = CubicSpline(hp_m, values[row])(np.maximum(hp_grid[inside], hp_m[0]))
-                else:
-                    table[row, inside, m] = np.interp(hp_grid[inside], hp_m, values[row])
-                table[row, ~inside, m] = beyond[row][~inside]
-        return table
+        beyond = np.stack([np.interp(hp_grid, hp[0, lowest], v[lowest]) for v in (labels[0] - y[0], tau)])
+        # Per row, the crossings in order of falling label (rising perigee), packed to the left.
+        valid = np.isfinite(crossing[0]).T[:, ::-1]
+        order = np.argsort(~valid, axis=1, kind="stable")
+        counts = valid.sum(axis=1)
+        knots = np.take_along_axis(crossing[0].T[:, ::-1], order, axis=1)
+        values = np.stack([labels[None, ::-1] - y_grid[:, None], crossing[1].T[:, ::-1]])
+        values = np.take_along_axis(values, order[None], axis=2)
+        packed = np.arange(labels.size) < counts[:, None]
+        assert np.all(np.diff(knots, axis=1)[packed[:, 1:]] > 0), "decay curves must not cross"
+        table = np.empty((2, y_grid.size, hp_grid.size))
+        splined = counts >= 4
+        table[:, splined] = _spline_rows(knots[splined], values[:, splined], counts[splined], hp_grid)
+        for m in np.flatnonzero(~splined):  # too few crossings for a cubic: straight lines
+            n = counts[m]
+            table[:, m] = [np.interp(hp_grid, knots[m, :n], v[m, :n]) for v in values]
+        top = knots[np.arange(y_grid.size), counts - 1]
+        inside = hp_grid[None, :] <= top[:, None]
+        table = np.where(inside, table, beyond[:, None, :])
+        return np.ascontiguousarray(table.transpose(0, 2, 1))
 
     def _build_table_b(self, hp: FloatArray, y: FloatArray, q: FloatArray) -> FloatArray:
         """Each curve at equal steps of tau, held at its last value past its end."""
