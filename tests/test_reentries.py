@@ -1,13 +1,17 @@
-"""The documented re-entries of benchmarks/validate_reentries.py, pinned so they cannot drift silently.
+"""The hindcasts of benchmarks/validate_reentries.py, held against the OBSERVED re-entries.
 
-Each prediction is held to the value measured when docs/validation-modern.md was
-written (predicted / observed - 1, in the table of section 5) within 3 points.
-Why 3: the chunking, binning and curve interpolation were measured to move
-lifetimes by 0.1-0.5% (section 3) and GRACE's lifetime moves about twice as much
-as the density (C_D +5% gives -10%), so numerical refinements stay inside 3 points
-while a change to the physics (the atmosphere's averaging, the drag model, the
-solar record, a case's inputs) does not. The issue's bar (+-30%) is asserted
-separately, case by case, so a miss cannot be hidden by moving a pinned value.
+Every tolerance is on predicted / observed - 1, the observed life being the documented
+re-entry date minus the start (benchmarks/reentry_cases.csv), never the code's own output:
+
+* a case not listed in KNOWN_MISSES must be within +-25% of its observed life (the
+  issue's goal for 90% of the cases);
+* a known miss is outside +-25% (if it comes inside, the list and the docs are out of
+  date) and below its stated ceiling: the miss measured when docs/validation-modern.md
+  was written plus about 10 points, so it cannot grow unnoticed while numerical
+  refinements (0.1-0.5% on lifetimes, docs section 3) pass;
+* over all cases, the median |error| and its 90th percentile stay below ceilings set the
+  same way. The issue's goal (median 10%, 90th percentile 25%) is NOT met: measured
+  11.5% and 46%, see the docs for the misses and their likely reasons.
 """
 
 from __future__ import annotations
@@ -32,40 +36,58 @@ def validation():
     return module
 
 
-#: predicted / observed - 1 with the drag model, and its drag coefficient, as measured (docs table).
-MEASURED = {
-    "GFZ-1": (+0.114, 2.12),
-    "Starshine 1": (+0.028, 2.13),
-    "Starshine 2": (+0.337, 2.13),
-    "Starshine 3": (+0.007, 2.14),
-    "GOCE": (-0.053, 3.87),
-    "GRACE-2": (+0.056, 3.42),
-    "GRACE-1": (+0.042, 3.42),
+#: Within +-25% of the observed life unless listed: the known misses, each with its ceiling (measured miss).
+KNOWN_MISSES = {
+    "Sputnik 1": 1.00,  # +87.0%
+    "San Marco 2": 0.60,  # +46.8%
+    "San Marco 3": 0.55,  # +44.9%
+    "Starshine 2": 0.45,  # +33.7%
+    "Explorer 32": 0.45,  # +32.1%
+    "San Marco 4": 0.40,  # +26.5%
 }
-#: Known outside the +-30% bar (docs/validation-modern.md says why).
-KNOWN_MISSES = {"Starshine 2"}
-#: The quick subset: three cases of three shapes and lives from 3 weeks to 9 months (~6 s).
-QUICK = ("Starshine 1", "Starshine 2", "GOCE")
+WITHIN = 0.25
+#: Ceilings over all cases (measured: median 11.5%, 90th percentile 46.0%).
+MEDIAN_CEILING = 0.15
+P90_CEILING = 0.55
+#: The quick subset (~15 s): the record's first months (Sputnik 1), a 1960s sphere within the goal
+#: (San Marco 1), the slender GOCE and the modern miss (Starshine 2).
+QUICK = ("Sputnik 1", "San Marco 1", "Starshine 2", "GOCE")
 
 
 def check(rows):
     for row in rows:
         error = row.model_days / row.observed_days - 1.0
-        pinned, cd = MEASURED[row.name]
-        assert error == pytest.approx(pinned, abs=0.03), row.name
-        assert row.drag_coefficient == pytest.approx(cd, abs=0.01), row.name
-        assert (abs(error) <= 0.30) == (row.name not in KNOWN_MISSES), row.name
+        if row.name in KNOWN_MISSES:
+            assert WITHIN < abs(error) <= KNOWN_MISSES[row.name], (row.name, error)
+        else:
+            assert abs(error) <= WITHIN, (row.name, error)
 
 
-def test_quick_cases_pinned(validation):
-    cases = [c for c in validation.CASES if c.name in QUICK]
-    check(validation.run(cases, first_choice=False))
+def test_cases_come_from_the_sourced_table(validation):
+    # At least 12 documented decays (the issue's count), every one with its sources, from 1957 on.
+    cases = validation.CASES
+    assert len(cases) >= 12
+    assert all(case.source for case in cases)
+    assert min(case.start for case in cases) < "1958"
+    assert set(KNOWN_MISSES) <= {case.name for case in cases}
+
+
+def test_tumbling_cylinder_is_the_sphere_of_the_same_surface(validation):
+    # Explorer 1's 2.03 m x 0.152 m cylinder: surface 1.006 m^2, mean cross-section a quarter of it.
+    shape = validation.tumbling_cylinder(0.152, 2.03)
+    assert shape.sphere
+    assert shape.reference_area_m2 == pytest.approx((3.14159265 * 0.152 * 2.03 + 3.14159265 * 0.152**2 / 2) / 4)
+
+
+def test_quick_cases_against_their_observed_lives(validation):
+    check(validation.run([c for c in validation.CASES if c.name in QUICK], first_choice=False))
 
 
 @pytest.mark.slow
-def test_all_cases_pinned_and_within_the_bar(validation):
+def test_all_cases_against_their_observed_lives(validation):
     rows = validation.run(validation.CASES, first_choice=False)
     check(rows)
-    # The issue's target: at least three independent satellites within +-30% (GRACE-1/2 are twins).
-    independent = {row.name.split("-")[0] for row in rows if abs(row.model_days / row.observed_days - 1) <= 0.30}
-    assert len(independent) >= 3, independent
+    median, p90, within = validation.summary([row.model_days / row.observed_days - 1.0 for row in rows])
+    assert median <= MEDIAN_CEILING
+    assert p90 <= P90_CEILING
+    assert within == len(rows) - len(KNOWN_MISSES)
