@@ -91,3 +91,36 @@ def test_cli_reports_percentiles_dates_and_the_rule_as_a_probability(capsys):
 def test_a_bad_seed_names_the_flag(capsys):
     status, _, err = run(capsys, "lifetime", "--perigee", "300", "--apogee", "300", "--uncertainty", "--seed", "-1")
     assert status == 2 and err == "orbit-env: error: --seed -1 is out of range; allowed: an integer at least 0\n"
+
+
+def test_each_node_propagates_only_its_samples_with_the_same_lifetimes():
+    # lifetime_spread propagates at each solar node only the samples interpolated from it; the
+    # satellites of one propagation do not affect each other, so every sample's lifetime must be
+    # exactly the one from propagating all samples at every node (bit for bit).
+    pytest.importorskip("pymsis")
+    from orbit_env.decay.chunked import propagate
+    from orbit_env.decay.solar_record import load_record
+
+    record = load_record()
+    # From a month after the last observed day: all of the life in the forecast, which the nodes scale.
+    start = record.observed_end_days + 30.0
+    scenario = Scenario("msis", activity=record, epoch_days=start, rotating_atmosphere=True)
+    hp, c, n = 300e3, 0.0165, 60
+    spread = U.lifetime_spread(hp, hp, c, scenario, 51.6, samples=n, seed=11)
+    z, density, drag = U.sample_factors(n, 11)
+    base = scenario.solar_model(51.6)
+    log_days = []
+    for node in U.SOLAR_NODES:
+        factor = math.exp(U.SOLAR_FORECAST_SIGMA * node)
+        model = replace(base, activity=U.ScaledForecast(record, factor, record.observed_end_days))
+        days = propagate(np.full(n, hp), np.full(n, hp), c, model, density_scale=density * drag).days
+        log_days.append(np.log(days))
+    nodes = np.array(U.SOLAR_NODES)
+    right = np.clip(np.searchsorted(nodes, z), 1, nodes.size - 1)
+    w = (z - nodes[right - 1]) / (nodes[right] - nodes[right - 1])
+    cols = np.arange(n)
+    expected = np.exp(np.array(log_days)[right - 1, cols] * (1.0 - w) + np.array(log_days)[right, cols] * w)
+    assert np.all(spread.reentered)
+    assert set(np.unique(right)) == {1, 2, 3, 4}  # samples in every interval between the nodes
+    assert np.ptp(np.array(log_days)[:, 0]) > 0.01  # the nodes differ: the forecast's factor matters
+    np.testing.assert_array_equal(spread.days, expected)

@@ -24,9 +24,11 @@ Everything goes through the fast paths: a fixed profile's lifetime is inversely
 proportional to the density scale and the drag coefficient (Eq. 3.4: the decay rate is
 linear in rho c), so the samples of a fixed profile are one lifetime divided by their
 factors, exactly. With an epoch, the time-stepped decay (`orbit_env.decay.chunked`)
-runs once per solar node (`SOLAR_NODES`, values of z) with all samples at once, a
-vector of satellites each with its own density and drag factor; each sample's lifetime
-is then interpolated in z between the two nodes around it (linearly in log days). The
+runs once per solar node (`SOLAR_NODES`, values of z) with the samples that use that
+node at once, a vector of satellites each with its own density and drag factor; each
+sample's lifetime is then interpolated in z between the two nodes around it (linearly
+in log days). A node propagates only its own samples (the outer nodes about a sixth of
+them), so it stops when they have re-entered, not the longest-lived of all. The
 interpolation error is measured in ``tests/test_uncertainty.py`` against samples
 propagated one by one. (A grid in the factor as well is cheaper but misses by up to 4%:
 the lifetime is not smooth in the factor where the fall meets a turn of the solar cycle.)
@@ -153,8 +155,6 @@ def lifetime_spread(
     z_sun, density, drag = sample_factors(samples, seed)
     scale = density * drag
     sources = {"density_model": DENSITY_MODEL_SIGMA, "drag_coefficient": DRAG_COEFFICIENT_SIGMA}
-    hp = np.full(z_sun.size, float(perigee_m))
-    ha = np.full(z_sun.size, float(apogee_m))
     if not scenario.time_varying:
         days, reentered = scenario.lifetime_days(perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
         return LifetimeSpread(float(days) / scale, np.full(scale.size, bool(reentered)), seed, sources)
@@ -164,24 +164,33 @@ def lifetime_spread(
     activity = scenario.solar
     after = getattr(activity, "observed_end_days", -math.inf)
     base = scenario.solar_model(inclination_deg)
-    # All samples at once at each solar node (a vector of satellites, each with its own density and drag
-    # factor); each sample's lifetime is then interpolated in z between the nodes, in log days.
+    # Each sample's lifetime is interpolated in z between the two nodes around it, in log days.
     nodes = np.array(SOLAR_NODES)
-    hp = np.full(z_sun.size, float(perigee_m))
-    ha = np.full(z_sun.size, float(apogee_m))
-    node_days, node_up = [], []
-    for z in SOLAR_NODES:
-        model = replace(base, activity=ScaledForecast(activity, math.exp(SOLAR_FORECAST_SIGMA * z), after))
-        result = propagate(hp, ha, drag_parameter_m2_kg, model, density_scale=scale * scenario.density_scale)
-        node_days.append(result.days)
-        node_up.append(result.reentered)
-    log_days = np.log(np.maximum(np.array(node_days), 1e-6))
     right = np.clip(np.searchsorted(nodes, z_sun), 1, nodes.size - 1)
     left = right - 1
     w = (z_sun - nodes[left]) / (nodes[right] - nodes[left])
+    # At each node, the samples that use it at once (a vector of satellites, each with its own
+    # density and drag factor): a node then runs only until its own samples have re-entered, and
+    # the samples' lifetimes are those of propagating all of them at every node (each satellite
+    # is propagated on its own arithmetic; the others in the vector do not change it).
+    log_days = np.zeros((nodes.size, z_sun.size))
+    up = np.zeros((nodes.size, z_sun.size), dtype=bool)
+    # The nominal forecast's node first: it runs on the days the nominal lifetime ran just before
+    # (the command line's), whose NRLMSIS ratios are still in chunked's in-memory cache.
+    for k in np.argsort(np.abs(nodes), kind="stable"):
+        z = float(nodes[k])
+        needed = np.flatnonzero((left == k) | (right == k))
+        if needed.size == 0:
+            continue
+        model = replace(base, activity=ScaledForecast(activity, math.exp(SOLAR_FORECAST_SIGMA * z), after))
+        height_p, height_a = np.full(needed.size, float(perigee_m)), np.full(needed.size, float(apogee_m))
+        result = propagate(
+            height_p, height_a, drag_parameter_m2_kg, model, density_scale=scale[needed] * scenario.density_scale
+        )
+        log_days[k, needed] = np.log(np.maximum(result.days, 1e-6))
+        up[k, needed] = result.reentered
     cols = np.arange(z_sun.size)
     days = np.exp(log_days[left, cols] * (1.0 - w) + log_days[right, cols] * w)
-    up = np.array(node_up)
     reentered = up[left, cols] & up[right, cols]
     cap = base.max_years * 365.25
     days = np.where(reentered, np.minimum(days, cap), cap)

@@ -1,0 +1,89 @@
+"""The cost of ``--uncertainty``: 1000 Monte Carlo samples against one lifetime of the same orbit.
+
+Whole processes (``python -m orbit_env.cli lifetime ...``), as a user runs them: a 3U
+cubesat (4 kg, 0.03 m^2, c_x 2.2) at 550 km, inclination 97.5 deg, air co-rotating,
+under NRLMSIS with the shipped solar record from an epoch (``--epoch``). The
+issue's target: ``--uncertainty --samples 1000`` at most 20 times one lifetime.
+
+The disk cache (curves and NRLMSIS profiles of every solar bin) is a temporary folder,
+warmed by one run of the uncertainty command before anything is timed, so both
+commands read the same tables from disk: the ratio is the cost of the samples, not of
+tables built once per machine. ``--cold`` also times both commands from an empty
+cache (each in a folder of its own), where the samples' solar bins are built too.
+
+Then it prints the uncertainty command's own output with ``--rule 5`` (the band and
+the compliance probability under the 5-year rule).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+EPOCH = "2026-12-01"
+ORBIT = ["--perigee", "550", "--apogee", "550", "--inclination", "97.5", "--rotating-atmosphere"]
+SATELLITE = ["--mass", "4", "--area", "0.03", "--cx", "2.2"]
+ONE = [sys.executable, "-m", "orbit_env.cli", "lifetime", *ORBIT, *SATELLITE, "--epoch", EPOCH]
+SAMPLES = ["--uncertainty", "--samples", "1000", "--seed", "0"]
+
+
+def timed(command: list[str], env: dict[str, str], repeats: int) -> tuple[float, float]:
+    """Median wall time and median CPU time (user + system) of a whole process [s].
+
+    The CPU time is what the process itself computed: on a machine shared with other
+    work it moves less than the wall time, which waits for the cores.
+    """
+    walls, cpus = [], []
+    for _ in range(repeats):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        start = time.perf_counter()
+        subprocess.run(command, check=True, capture_output=True, env=env)
+        walls.append(time.perf_counter() - start)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return statistics.median(walls), statistics.median(cpus)
+
+
+def report(label: str, one: tuple[float, float], spread: tuple[float, float]) -> None:
+    """Print both commands' times and the ratios."""
+    print(label)
+    print(f"   one lifetime              {one[0]:8.2f} s wall {one[1]:8.2f} s CPU")
+    print(f"   --uncertainty (1000)      {spread[0]:8.2f} s wall {spread[1]:8.2f} s CPU")
+    print(f"   ratio                     {spread[0] / one[0]:8.1f}x wall {spread[1] / one[1]:7.1f}x CPU")
+
+
+def main() -> None:
+    """Time one lifetime and the 1000-sample uncertainty of the same orbit; print their ratio."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3, help="runs per timing (median)")
+    parser.add_argument("--cold", action="store_true", help="also time both from an empty disk cache")
+    args = parser.parse_args()
+    machine = platform.processor() or platform.machine()
+    print(f"machine: {machine}, {os.cpu_count()} cores, Python {sys.version.split()[0]}")
+    print(f"orbit: {' '.join(ONE[3:])}")
+    env = {**os.environ, "ORBIT_ENV_CACHE_DIR": tempfile.mkdtemp(prefix="orbit-env-bench-")}
+    subprocess.run([*ONE, *SAMPLES], check=True, capture_output=True, env=env)  # warm the disk cache
+    one = timed(ONE, env, args.repeats)
+    spread = timed([*ONE, *SAMPLES], env, args.repeats)
+    report(f"whole processes, disk cache warm, medians of {args.repeats}:", one, spread)
+    if args.cold:
+        cold = [{**os.environ, "ORBIT_ENV_CACHE_DIR": tempfile.mkdtemp(prefix="orbit-env-bench-")} for _ in range(2)]
+        report(
+            "whole processes, disk cache empty, one run each:",
+            timed(ONE, cold[0], 1),
+            timed([*ONE, *SAMPLES], cold[1], 1),
+        )
+    out = subprocess.run([*ONE, *SAMPLES, "--rule", "5"], check=True, capture_output=True, text=True, env=env)
+    print(f"$ orbit-env lifetime {' '.join([*ONE[4:], *SAMPLES, '--rule', '5'])}")
+    print(out.stdout, end="")
+
+
+if __name__ == "__main__":
+    main()
