@@ -263,8 +263,9 @@ def _spline_rows(x: FloatArray, y: FloatArray, counts: NDArray[np.intp], query: 
     c3, c2, c1, c0 = t / dx, (slope - s[..., :-1]) / dx - t, s[..., :-1], y[..., :-1]
     interval = np.empty((rows, query.size), dtype=np.intp)
     for row in range(rows):
-        n = last[row] + 1
-        interval[row] = np.clip(np.searchsorted(x[row, :n], query, side="right") - 1, 0, n - 2)
+        interval[row] = np.searchsorted(x[row, : last[row] + 1], query, side="right")
+    interval -= 1
+    np.clip(interval, 0, (last - 1)[:, None], out=interval)  # the first and last interval extrapolate
     z = np.clip(query[None, :], x[:, :1], x[r, last][:, None]) - np.take_along_axis(x, interval, axis=1)
     out = np.empty((y.shape[0], rows, query.size))
     for m in range(y.shape[0]):
