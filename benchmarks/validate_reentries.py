@@ -1,7 +1,7 @@
 """Hindcasts of documented re-entries from launch or a documented epoch, one method for all (validation-modern.md).
 
 Run: python benchmarks/validate_reentries.py [--plot docs/validation-modern.png] [--sensitivity]
-(needs pymsis; about 2 minutes for the 15 cases on a cold cache)
+(needs pymsis; about 4.5 minutes for the 15 cases on a cold cache on a shared 2-core machine)
 
 The cases, their inputs and sources are in ``benchmarks/reentry_cases.csv`` (one row each;
 its ``source`` column names where every number comes from, and says "from memory" where
