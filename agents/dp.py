@@ -51,7 +51,10 @@ For every action the successor and reward are computed once (in chunks, so the
 curves' tables stay in cache), stored as a scipy.sparse interpolation matrix P_a
 and a vector r_a, and then V_k = max_a (r_a + P_a V_{k-1}) on the deciding
 states of stage k, for k = 1..horizon, V_0 = 0, in float32; the values are
-stored as uint16 in steps of 0.01 day. The policy acts by the same one-step
+stored as uint16 in steps of 0.01 day, each stage compressed as its increments
+over the stage before (`orbit_env.agents.stage_values`: 825 MB of values in 96 MB
+on the default grid), and the solution is kept in the disk cache
+(`orbit_env.cache`), so it is solved again only when its inputs change. The policy acts by the same one-step
 look-ahead from the state recovered from the observation: argmax_a r_a(s) +
 V_{k-1}(successor), with V_{k-1} interpolated, or the exact sum of the coasts'
 days where the successor outlives the mission.
@@ -97,6 +100,8 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from orbit_env import cache
+from orbit_env.agents.stage_values import StageValues
 from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
@@ -355,8 +360,7 @@ class DPSolution:
     solve_s: float
     _model: _Model
     _axes: _Axes
-    _values: NDArray[np.uint16]  # the decision states of every stage, in units of VALUE_QUANTUM_DAYS
-    _offsets: NDArray[np.int64]  # where stage k's values start in _values
+    _stages: StageValues  # the decision states of every stage, in units of VALUE_QUANTUM_DAYS
     _rows: NDArray[np.int64]  # decision states of stage k (a prefix of the state vector)
     _cumulative: FloatArray  # sums of the coasts' days along the life levels [days]
     _coast_certain: int  # stages up to which the satellites that outlive them coast
@@ -370,7 +374,7 @@ class DPSolution:
     @property
     def stored_values(self) -> int:
         """Values stored over all stages (the decision states)."""
-        return int(self._values.size)
+        return int(self._rows[1:].sum())
 
     def _coast_days(self, stage: int, rows: NDArray[np.intp]) -> FloatArray:
         """The days of ``stage`` coasts from grid states that outlive them [days]."""
@@ -393,7 +397,7 @@ class DPSolution:
             return np.zeros(rows.shape)
         out = np.empty(rows.shape)
         stored = rows < self._rows[stage]
-        out[stored] = self._values[self._offsets[stage] + rows[stored]] * VALUE_QUANTUM_DAYS
+        out[stored] = self._stages.get(stage)[rows[stored]] * VALUE_QUANTUM_DAYS
         if not stored.all():
             out[~stored] = self._coast_days(stage, rows[~stored])
         return out
@@ -505,7 +509,13 @@ def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArra
     burns = [b for b in config.burn_sizes_m_s if b != 0.0] if has_coast else list(config.burn_sizes_m_s)
     actions = [0.0] * has_coast + burns
     rewards = np.zeros((len(actions), n), np.float32)
-    parts: list[list[tuple[Any, Any, Any]]] = [[] for _ in actions]
+    # Each matrix is filled in place: at most 8 entries a row, reserved (np.empty: untouched pages
+    # take no memory) so that no chunk lists are joined at the end, which doubled the peak.
+    index_dtype = np.int32 if 8 * n < np.iinfo(np.int32).max else np.int64
+    counts = [np.zeros(n, np.uint8) for _ in actions]
+    indices = [np.empty(8 * n, index_dtype) for _ in actions]
+    data = [np.empty(8 * n, np.float32) for _ in actions]
+    filled = [0 for _ in actions]
     down = axes.life_per_step * axes.plane
     for start in range(0, n, CHUNK_STATES):
         rows = np.arange(start, min(start + CHUNK_STATES, n))
@@ -514,7 +524,6 @@ def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArra
         for a, burn in enumerate(actions):
             coasting = has_coast and a == 0
             if not coasting and start >= decision_rows:
-                parts[a].append((np.zeros(rows.size, np.int64), np.zeros(0, np.int32), np.zeros(0, np.float32)))
                 continue
             step = model.step(states, burn)
             index, weight = _interpolation(axes, step.state.label, step.life, step.state.dv_left_m_s)
@@ -526,15 +535,16 @@ def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArra
                 assert np.all(index[unit][keep[unit]] == rows[unit] - down), "a coast moves one step down"
                 keep &= (rows >= unit_rows)[:, None]
             keep &= (rows < decision_rows)[:, None]
-            parts[a].append((keep.sum(axis=1), index[keep].astype(np.int32), weight[keep].astype(np.float32)))
+            counts[a][rows] = keep.sum(axis=1)
+            begin, end = filled[a], filled[a] + int(counts[a][rows].sum())
+            indices[a][begin:end] = index[keep]
+            data[a][begin:end] = weight[keep]
+            filled[a] = end
     matrices = []
-    for part in parts:
-        indptr = np.concatenate([[0], np.cumsum(np.concatenate([p[0] for p in part]))])
-        indices = np.concatenate([p[1] for p in part])
-        data = np.concatenate([p[2] for p in part])
-        # One index type for both (int32 while it fits), so that the stages' row prefixes copy nothing.
-        index_dtype = np.int32 if indptr[-1] < np.iinfo(np.int32).max and n < np.iinfo(np.int32).max else np.int64
-        matrix = sp.csr_matrix((data, indices.astype(index_dtype), indptr.astype(index_dtype)), shape=(n, n))
+    for a in range(len(actions)):
+        indptr = np.concatenate([np.zeros(1, index_dtype), np.cumsum(counts[a], dtype=index_dtype)])
+        matrix = sp.csr_matrix((data[a][: filled[a]], indices[a][: filled[a]], indptr), shape=(n, n))
+        # One index type for both, so that the stages' row prefixes copy nothing.
         assert matrix.indptr.dtype == matrix.indices.dtype == index_dtype
         matrices.append(matrix)
     tail_coast = None
@@ -549,8 +559,71 @@ def _prefix(matrix: Any, rows: int) -> Any:
     return sp.csr_matrix((matrix.data, matrix.indices, matrix.indptr[: rows + 1]), shape=(rows, matrix.shape[1]))
 
 
+#: The disk cache's kind for DP solutions.
+CACHE_KIND = "dp"
+
+
+def _cache_description(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float) -> str | None:
+    return cache.describe((config, grid, density_scale))
+
+
+def _tail_states(model: _Model, axes: _Axes) -> BatchState:
+    """The states of the life axis' tail (above the horizon + 1)."""
+    return _grid_states(model, axes, np.arange(axes.unit_levels * axes.plane, axes.size))
+
+
+def _to_cache(solution: DPSolution) -> dict[str, np.ndarray]:
+    axes = solution._axes
+    return {
+        **solution._stages.to_arrays(),
+        "label": axes.label,
+        "life": axes.life,
+        "dv_m_s": axes.dv_m_s,
+        "levels": np.array([axes.unit_levels, axes.life_per_step, solution._coast_certain]),
+        "rows": solution._rows,
+        "cumulative": solution._cumulative,
+        "solve_s": np.array(solution.solve_s),
+    }
+
+
+def _from_cache(
+    config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, arrays: dict[str, np.ndarray]
+) -> DPSolution:
+    model = _Model(config, density_scale)
+    unit_levels, life_per_step, certain = (int(x) for x in arrays["levels"])
+    axes = _Axes(arrays["label"], arrays["life"], arrays["dv_m_s"], unit_levels, life_per_step)
+    return DPSolution(
+        config,
+        density_scale,
+        grid,
+        float(arrays["solve_s"]),
+        model,
+        axes,
+        StageValues.from_arrays(arrays),
+        arrays["rows"],
+        arrays["cumulative"],
+        certain,
+        _tail_states(model, axes),
+    )
+
+
 @lru_cache(maxsize=4)
 def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, progress: bool) -> DPSolution:
+    description = _cache_description(config, grid, density_scale)
+    arrays = cache.load(CACHE_KIND, description)
+    if arrays is not None:
+        if progress:
+            print("dp: solution read from the disk cache", file=sys.stderr)
+        return _from_cache(config, grid, density_scale, arrays)
+    solution = _backward_induction(config, grid, density_scale, progress)
+    # Stored uncompressed: the stages are compressed already.
+    cache.store(CACHE_KIND, description, _to_cache(solution), compress=False)
+    return solution
+
+
+def _backward_induction(
+    config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, progress: bool
+) -> DPSolution:
     start = time.perf_counter()
     model = _Model(config, density_scale)
     axes = _axes(model, grid)
@@ -570,12 +643,10 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
         for residue in range(axes.life_per_step):
             levels[residue :: axes.life_per_step] = np.cumsum(levels[residue :: axes.life_per_step], axis=0)
         cumulative = levels.ravel().astype(np.float32)
-    offsets = np.concatenate([[0], np.cumsum(rows)[:-1]]).astype(np.int64)
-    # Values are stored as uint16 in steps of VALUE_QUANTUM_DAYS: half of float32's memory,
-    # far below the grid's own error.
-    values = np.zeros(int(rows.sum()), dtype=np.uint16)
+    # Values are stored as uint16 in steps of VALUE_QUANTUM_DAYS, far below the grid's own
+    # error, each stage compressed (see the module).
+    stages = StageValues(rows)
     top = np.iinfo(np.uint16).max * VALUE_QUANTUM_DAYS
-    tail = _grid_states(model, axes, np.arange(unit_rows, n))
     solution = DPSolution(
         config,
         density_scale,
@@ -583,12 +654,11 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
         0.0,
         model,
         axes,
-        values,
-        offsets,
+        stages,
         rows,
         cumulative,
         certain,
-        tail,
+        _tail_states(model, axes),
     )
     # The tail's states that a burn from a deciding state lands next to (the others are never read).
     referenced = max((int(m.indices.max(initial=0)) for m in [*matrices, tail_coast] if m is not None), default=0)
@@ -620,13 +690,14 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
         np.maximum(best, 0.0, out=stored)
         stored *= 1.0 / VALUE_QUANTUM_DAYS
         np.rint(stored, out=stored)
-        values[offsets[k] : offsets[k] + r] = stored
+        # The values grow with the steps left (every coast earns >= 0 days): checked on the last stage.
+        if k == horizon and stored.max(initial=0.0) > np.iinfo(np.uint16).max:
+            raise ValueError(f"values above {top:g} days: horizon too long")
+        stages.append(stored.astype(np.uint16))
         v, new = new, v
         if progress and k % 73 == 0:
             print(f"dp: stage {k}/{horizon}, {time.perf_counter() - start:.1f} s", file=sys.stderr)
-    # The values grow with the steps left (every coast earns >= 0 days): the last stage holds the largest.
-    if v.max(initial=0.0) > top:
-        raise ValueError(f"values above {top:g} days: horizon too long")
+    stages.finish()
     solution.solve_s = time.perf_counter() - start
     return solution
 
