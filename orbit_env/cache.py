@@ -1,6 +1,6 @@
 """A disk cache for the tables that take long to build: universal curves, NRLMSIS profiles, DP solutions.
 
-Each entry is one compressed ``.npz`` file of named arrays in the user's cache folder
+Each entry is one ``.npz`` file (compressed unless its arrays are already) of named arrays in the user's cache folder
 (``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux),
 under a name made from a hash of everything that shapes the table: its kind, a
 description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
@@ -127,8 +127,12 @@ def load(kind: str, description: str | None) -> dict[str, np.ndarray] | None:
         return None  # unreadable (truncated by a crash, another format): built again and rewritten
 
 
-def store(kind: str, description: str | None, arrays: dict[str, np.ndarray]) -> None:
-    """Write a table's arrays to the cache, atomically; a cache that cannot be written is passed over."""
+def store(kind: str, description: str | None, arrays: dict[str, np.ndarray], *, compress: bool = True) -> None:
+    """Write a table's arrays to the cache, atomically; a cache that cannot be written is passed over.
+
+    ``compress=False`` for arrays that are compressed already (deflating them again costs
+    seconds and saves nothing).
+    """
     path = None if description is None else _path(kind, description)
     if path is None:
         return
@@ -137,7 +141,7 @@ def store(kind: str, description: str | None, arrays: dict[str, np.ndarray]) -> 
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
         try:
             with os.fdopen(handle, "wb") as file:
-                np.savez_compressed(file, **arrays)
+                (np.savez_compressed if compress else np.savez)(file, **arrays)
             os.replace(temporary, path)
         except BaseException:
             Path(temporary).unlink(missing_ok=True)

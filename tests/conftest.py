@@ -6,3 +6,13 @@ from hypothesis import HealthCheck, settings
 settings.register_profile("ci", deadline=None, max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile("dev", deadline=None, max_examples=100)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+
+def pytest_configure(config):
+    # The tests read and write a disk cache of their own (the universal curves, NRLMSIS
+    # profiles, DP solutions), not the user's: a run is not changed by what an earlier one
+    # left, and leaves the user's cache as it was.
+    if "ORBIT_ENV_CACHE_DIR" not in os.environ:
+        import tempfile
+
+        os.environ["ORBIT_ENV_CACHE_DIR"] = tempfile.mkdtemp(prefix="orbit-env-tests-")

@@ -155,10 +155,10 @@ def test_coasting_where_the_satellite_outlives_the_mission_changes_no_value(monk
     # life levels up to the horizon agree to 0.05 day (measured 0.04: the tail's
     # coasts are then interpolated, and the values stored in steps of 0.01 day).
     config = OrbitRaisingConfig(**{**CONFIG.__dict__, "propellant_cost_per_m_s": cost})
-    restricted = dp._solve.__wrapped__(config, GRID, 1.0, False)
+    restricted = dp._backward_induction(config, GRID, 1.0, False)
     assert restricted._coast_certain == (60 if cost == 0.05 else 48)
     monkeypatch.setattr(dp, "_coast_certain_stages", lambda model: 0)
-    everywhere = dp._solve.__wrapped__(config, GRID, 1.0, False)
+    everywhere = dp._backward_induction(config, GRID, 1.0, False)
     assert everywhere.stored_values == (config.horizon_steps + 1 - 1) * everywhere.num_states
     unit = restricted._axes.unit_levels * restricted._axes.plane
     for k in (1, 30, 48, 60):
@@ -191,6 +191,25 @@ def test_solutions_are_cached_and_coarse_grids_solve():
     coarse = solve(CONFIG, grid=(4, 1, 1))
     assert solve(CONFIG, grid=(4, 1, 1)) is coarse
     assert np.isfinite(coarse.value(200.0, 500.0, 300.0, 60))
+
+
+def test_a_solution_read_from_the_disk_cache_is_the_one_solved(monkeypatch, tmp_path):
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
+    solved = dp._solve.__wrapped__(CONFIG, GRID, 1.0, False)
+    assert list(tmp_path.glob("dp-*.npz")), "the solution is written to the cache"
+
+    def refuse(*args):
+        raise AssertionError("solved again although cached")
+
+    monkeypatch.setattr(dp, "_backward_induction", refuse)
+    read = dp._solve.__wrapped__(CONFIG, GRID, 1.0, False)
+    for k in range(1, CONFIG.horizon_steps + 1):
+        np.testing.assert_array_equal(read.stage_values(k), solved.stage_values(k))
+    np.testing.assert_array_equal(read._axes.label, solved._axes.label)
+    starts = np.array([[200.0, 500.0], [300.0, 900.0], [250.0, 260.0]])
+    np.testing.assert_array_equal(
+        read.value(starts[:, 0], starts[:, 1], 300.0, 60), solved.value(starts[:, 0], starts[:, 1], 300.0, 60)
+    )
 
 
 @pytest.mark.parametrize(
