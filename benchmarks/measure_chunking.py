@@ -1,8 +1,13 @@
 """Chunk length and bin step of the time-varying decay against a day-by-day reference.
 
-Prints the lifetime error of ``orbit_env.decay.chunked.propagate`` for several chunk
-lengths and bin steps against ``integrate_reference`` (averaged equations in time,
-a fresh NRLMSIS profile every day). Needs pymsis; takes a few minutes.
+``python benchmarks/measure_chunking.py [WORD ...]`` prints the lifetime error of
+``orbit_env.decay.chunked.propagate`` for several chunk lengths and bin steps against
+``integrate_reference`` (averaged equations in time, a fresh NRLMSIS profile every
+day), for the cases whose name contains a WORD (all by default; a few minutes).
+
+``python benchmarks/measure_chunking.py short`` prints instead the short lives (10-40
+days) under the shipped record, in seven storms and five quiet spells, on circular
+orbits and orbits 20 km and 120 km wide: 108 cases, about six minutes. Needs pymsis.
 """
 
 import sys
@@ -12,6 +17,27 @@ import numpy as np
 
 from orbit_env.decay.chunked import SolarDecayModel, cached_curves, integrate_reference, propagate
 from orbit_env.decay.solar import CycleActivity, TableActivity, unix_days
+
+#: Starts a week or so before a storm (its day in the comment), and quiet spells.
+SHORT_LIFE_STARTS = [
+    ("1989-03-05", "storm"),  # 1989-03-13
+    ("2000-07-08", "storm"),  # 2000-07-15, the Bastille Day event
+    ("2001-10-28", "storm"),  # 2001-11-06
+    ("2003-10-20", "storm"),  # 2003-10-29 to 31, the Halloween storms
+    ("2004-10-30", "storm"),  # 2004-11-08
+    ("2015-03-08", "storm"),  # 2015-03-17, St Patrick's Day
+    ("2024-05-01", "storm"),  # 2024-05-10
+    ("2009-01-01", "quiet"),
+    ("2019-06-01", "quiet"),
+    ("2015-05-01", "quiet"),
+    ("1996-06-01", "quiet"),
+    ("2008-07-01", "quiet"),
+]
+#: Perigee and apogee offsets [m] from the circular height found for each life.
+SHORT_LIFE_SHAPES = [(0.0, 0.0), (0.0, 20e3), (-20e3, 100e3)]
+#: Lives aimed at [days].
+SHORT_LIFE_TARGETS = (12.0, 25.0, 38.0)
+C_CUBESAT_M2_KG = 0.0165  # a 3U cubesat: c_x 2.2, 0.03 m^2, 4 kg
 
 
 def synthetic_table(start_days: float, years: float, seed: int = 7) -> TableActivity:
@@ -25,14 +51,49 @@ def synthetic_table(start_days: float, years: float, seed: int = 7) -> TableActi
     return TableActivity(days, f107, f107a, ap, source="synthetic")
 
 
+def short_lives() -> None:
+    """The chunked decay of 10-40 day lives under the shipped record against the daily reference."""
+    from orbit_env.decay.solar_record import load_record
+
+    record = load_record()
+    errors = []
+    print(f"{'start':10} {'kind':5} {'orbit km':>13} {'reference d':>11} {'chunked d':>9} {'error':>8}")
+    for date, kind in SHORT_LIFE_STARTS:
+        for dp, da in SHORT_LIFE_SHAPES:
+            model = SolarDecayModel(record, unix_days(date), 51.6, follow_season=True, rotating_atmosphere=True)
+            # Heights for the target lives, from the chunked decay itself (one vectorized run).
+            heights = np.arange(180e3, 400e3, 5e3)
+            lives = propagate(heights + dp, heights + da, C_CUBESAT_M2_KG, model).days
+            for target in SHORT_LIFE_TARGETS:
+                h = float(np.interp(target, lives, heights))
+                hp, ha = round(h + dp, -3), round(h + da, -3)
+                reference = integrate_reference(hp, ha, C_CUBESAT_M2_KG, model)
+                if not 10.0 <= reference <= 40.0:
+                    continue
+                days = float(propagate(hp, ha, C_CUBESAT_M2_KG, model).days[0])
+                errors.append((reference, ha - hp, days / reference - 1.0))
+                orbit = f"{hp / 1e3:.0f} x {ha / 1e3:.0f}"
+                print(f"{date:10} {kind:5} {orbit:>13} {reference:11.3f} {days:9.3f} {days / reference - 1:+8.3%}")
+    table = np.array(errors)
+    for name, chosen in (("10-20 days", table[:, 0] < 20.0), ("20-40 days", table[:, 0] >= 20.0)):
+        worst = np.abs(table[chosen, 2])
+        print(
+            f"{name}: {chosen.sum()} cases, median |error| {np.median(worst):.2%}, max {worst.max():.2%}, "
+            f"{(worst > 5e-3).sum()} above 0.5%"
+        )
+
+
 def main() -> None:
+    only = sys.argv[1:]
+    if only == ["short"]:
+        short_lives()
+        return
     start = unix_days("2021-06-01")
     cases = [
         ("cycle, circular 450 km", CycleActivity(), 450e3, 450e3, 2.2 * 1.0 / 100.0),
         ("cycle, 300 x 1000 km", CycleActivity(), 300e3, 1000e3, 2.2 * 1.0 / 40.0),
         ("daily table, circular 420 km", synthetic_table(start, 6.0), 420e3, 420e3, 2.2 * 1.0 / 100.0),
     ]
-    only = sys.argv[1:]
     for name, activity, hp, ha, c in cases:
         if only and not any(word in name for word in only):
             continue

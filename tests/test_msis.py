@@ -150,3 +150,14 @@ def test_scale_multiplies_density_and_divides_lifetime(iss_like):
     doubled = lifetime(450.0, 450.0, satellite=satellite, atmosphere=scaled, method="curves")
     # nu scales exactly as 1/s; the curves interpolate, so allow their 0.5%.
     assert doubled.days == pytest.approx(base.days / 2.0, rel=5e-3)
+
+
+def test_densities_over_inclinations_in_one_call_equal_the_per_inclination_average():
+    from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
+
+    heights_m = np.array([200e3, 400e3, 800e3])
+    inclinations = [0.0, 51.6, 97.0]
+    rows = mean_density_over_inclinations_kg_m3(heights_m, 150.0, 140.0, 15.0, inclinations, latitude_nodes=6)
+    for row, inclination in zip(rows, inclinations, strict=True):
+        expected = mean_density_kg_m3(heights_m, 150.0, 140.0, 15.0, inclination, None, latitude_nodes=6)
+        assert row == pytest.approx(expected, rel=1e-12)

@@ -19,11 +19,19 @@ also ``complies``, ``new_perigee_km``, ``dv_m_s``; and ``status``: ``ok``, or wh
 the row has no lifetime (unreadable, invalid heights, outside the curves' domain,
 still in orbit at the time-stepped path's cap). A bad row never stops the batch.
 
-With NRLMSIS the profile depends on the inclination: rows are grouped by
-inclination rounded to ``INCLINATION_STEP_DEG`` (1 deg moves a lifetime by about
-0.5%, measured at 50 deg and 400 km, so rounding costs at most 0.25%), one curve
-family per group (0.9 s to build). The paper's and the exponential law in still air
-do not depend on it: one group.
+With NRLMSIS the profile depends on the inclination (and in co-rotating air the
+drag does): rows are grouped by inclination rounded to ``INCLINATION_STEP_DEG``
+(1 deg moves a lifetime by about 0.5%, measured at 50 deg and 400 km, so rounding
+costs at most 0.25%). Up to ``MAX_FAMILIES`` groups get a curve family each (0.9 s
+to build). A catalogue spread over more groups takes one family, that of its most
+common inclination, and each row's own inclination as a density multiplier along
+its decay: the ratio of NRLMSIS at the row's inclination to the family's (computed
+every ``ANCHOR_STEP_DEG`` in one NRLMSIS call and interpolated in inclination,
+weighted over the orbit as drag weights it, `orbit_env.decay.chunked.orbit_ratio`),
+and of the co-rotating air's drag, integrated over the decay: the time is
+Int dW / (g c s) along the family's curve. Its error against a family per 1-degree
+group is measured in ``benchmarks/bench_msis.py`` (docs/validation-modern.md). The
+paper's and the exponential law in still air do not depend on the inclination: one group.
 """
 
 from __future__ import annotations
@@ -52,13 +60,29 @@ from orbit_env.analysis.lifetime import (
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, G0_M_S2, MU_EARTH_M3_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import cell_value, read_csv
-from orbit_env.decay.curves import UniversalCurves
+from orbit_env.decay.chunked import orbit_ratio
+from orbit_env.decay.curves import NU_REF, UniversalCurves
+from orbit_env.physics.orbit import elements_from_heights
 
 FloatArray = NDArray[np.float64]
 
 #: Inclination bins of NRLMSIS batches [deg].
 INCLINATION_STEP_DEG = 1.0
+#: A catalogue with more inclination groups than this takes one curve family and a density ratio.
+MAX_FAMILIES = 2
+#: Widest orbit [m] (apogee - perigee height) on that path: the ratio is one multiplier for the perigee
+#: and the eccentricity decay alike, which holds for near-circular orbits (error measured in the module docstring).
+SPREAD_MAX_SPAN_M = 100e3
+#: Inclinations [deg] at which a spread catalogue's NRLMSIS ratio is computed (interpolated between).
+ANCHOR_STEP_DEG = 10.0
+#: Heights [m] of the ratio (uniform: the rows' tables are read by index).
+RATIO_HEIGHTS_M = np.arange(100e3, 1200e3 + 1.0, 25e3)
+#: NRLMSIS nodes of the ratio; numerator and denominator alike, so the coarser sampling cancels.
+RATIO_NODES = {"latitude_nodes": 12, "local_time_nodes": 6}
+#: Points along each decay (equal steps of the curves' tau) where the multiplier is taken.
+PATH_NODES = 48
 #: Satellites per progress-bar step on the fixed-profile path.
 BLOCK = 20_000
 _ID_COLUMNS = ("name", "id")
@@ -163,6 +187,38 @@ def read_batch(
     return rows, hp_km * 1e3, ha_km * 1e3, c, inc, status
 
 
+def _spread_batch(
+    scenario: Scenario,
+    members: NDArray[np.intp],
+    group_of: FloatArray,
+    inputs: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    days: FloatArray,
+    reentered: NDArray[np.bool_],
+    bar: Any,
+) -> float:
+    """Lifetimes of ``members`` on one curve family and a ratio (module docstring); returns its inclination."""
+    perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg = inputs
+    values, counts = np.unique(group_of[members], return_counts=True)
+    reference = float(values[np.argmax(counts)])
+    curves = scenario.curves(reference)
+    log_ratio = inclination_log_ratio(scenario, reference, inclination_deg[members])
+    for block in np.array_split(np.arange(members.size), max(1, members.size // BLOCK)):
+        rows = members[block]
+        days[rows] = spread_lifetime_days(
+            curves,
+            scenario,
+            reference,
+            log_ratio[block],
+            inclination_deg[rows],
+            perigee_m[rows],
+            apogee_m[rows],
+            drag_parameter_m2_kg[rows],
+        )
+        reentered[rows] = True
+        bar.update(rows.size)
+    return reference
+
+
 def batch_lifetimes(
     rows: Sequence[dict[str, str]],
     perigee_m: FloatArray,
@@ -174,8 +230,13 @@ def batch_lifetimes(
     *,
     rule_years: float | None = None,
     progress: bool = True,
+    exact_groups: bool = False,
 ) -> tuple[list[dict[str, Any]], BatchSummary]:
-    """Lifetimes (and the rule check) of every valid row; output records in input order."""
+    """Lifetimes (and the rule check) of every valid row; output records in input order.
+
+    ``exact_groups`` builds a curve family per inclination group however many there
+    are (the reference the one-family path of a spread catalogue is measured against).
+    """
     n = len(rows)
     ok = np.array([s == "ok" for s in status])
     days = np.full(n, np.nan)
@@ -190,9 +251,24 @@ def batch_lifetimes(
         group_of = np.zeros(n)
     groups = np.unique(group_of[ok])
     cap_days = None if rule_years is None else (rule_years + 1.0) * 365.25
+    one_family = (
+        depends_on_inclination
+        and not scenario.time_varying
+        and rule_years is None
+        and not exact_groups
+        and groups.size > MAX_FAMILIES
+    )
+    near_circular = ok & (apogee_m - perigee_m <= SPREAD_MAX_SPAN_M)
+    by_groups = ok.copy()
+    families: set[float] = set()
     with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
-        for group in groups:
-            members = np.flatnonzero(ok & (group_of == group))
+        if one_family and near_circular.any():
+            inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
+            families.add(_spread_batch(scenario, np.flatnonzero(near_circular), group_of, inputs, days, reentered, bar))
+            by_groups &= ~near_circular
+        for group in np.unique(group_of[by_groups]):
+            families.add(float(group))
+            members = np.flatnonzero(by_groups & (group_of == group))
             inclination = float(group) if depends_on_inclination else float(inclination_deg[members[0]])
             blocks = [members] if scenario.time_varying else np.array_split(members, max(1, members.size // BLOCK))
             for block in blocks:
@@ -241,7 +317,94 @@ def batch_lifetimes(
         record["status"] = status[i]
         records.append(record)
     n_ok = sum(1 for s in status if s == "ok")
-    return records, BatchSummary(rows=n, ok=n_ok, groups=int(groups.size))
+    return records, BatchSummary(rows=n, ok=n_ok, groups=len(families))
+
+
+def inclination_log_ratio(scenario: Scenario, reference_deg: float, inclination_deg: FloatArray) -> FloatArray:
+    """ln(NRLMSIS density at each inclination / at ``reference_deg``) on ``RATIO_HEIGHTS_M``, shape (n, heights).
+
+    Zero for the other atmospheres (they do not depend on the inclination). NRLMSIS is
+    averaged over the year at every ``ANCHOR_STEP_DEG`` spanning the inclinations, in
+    one call, and its logarithm interpolated in inclination by a cubic spline.
+    """
+    inclination = np.asarray(inclination_deg, dtype=np.float64)
+    zero = np.zeros((inclination.size, RATIO_HEIGHTS_M.size))
+    if scenario.atmosphere != "msis":
+        return zero
+    from scipy.interpolate import make_interp_spline  # on use: half a second of start-up
+
+    from orbit_env.decay.solar import ConstantActivity
+    from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
+
+    low = np.floor(min(float(inclination.min()), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
+    high = np.ceil(max(float(inclination.max()), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
+    anchors = np.arange(low, high + 0.5 * ANCHOR_STEP_DEG, ANCHOR_STEP_DEG)
+    if anchors.size < 2:
+        return zero
+    solar = scenario.solar
+    assert isinstance(solar, ConstantActivity)
+    rho = mean_density_over_inclinations_kg_m3(
+        RATIO_HEIGHTS_M,
+        solar.f107_sfu,
+        solar.f107a_sfu,
+        solar.ap,
+        anchors,
+        scenario.ascending_node_local_time_h,
+        **RATIO_NODES,
+    )
+    spline = make_interp_spline(anchors, np.log(rho), k=min(3, anchors.size - 1), axis=0)
+    return np.asarray(spline(inclination) - spline(reference_deg)[None, :], dtype=np.float64)
+
+
+def spread_lifetime_days(
+    curves: UniversalCurves,
+    scenario: Scenario,
+    reference_deg: float,
+    log_ratio: FloatArray,
+    inclination_deg: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    drag_parameter_m2_kg: FloatArray,
+) -> FloatArray:
+    """Days to re-entry on the curves of ``reference_deg`` with each row's density multiplier along its decay.
+
+    Row k's multiplier at an orbit is exp(``log_ratio[k]``) at its height, weighted over
+    the orbit (`orbit_ratio`), times, in co-rotating air, the drag of the air's speed at
+    the perigee, ((v_p - Omega r_p cos i) / (v_p - Omega r_p cos i_ref))^2. The time is
+    Int dW / (g c s) along the reference curve, by the trapezoidal rule at ``PATH_NODES``
+    equal steps of tau; with s = 1 it is the curves' own lifetime exactly.
+    """
+    point = curves.locate(perigee_m, apogee_m)
+    steps = np.linspace(0.0, 1.0, PATH_NODES + 1)
+    tau = point.tau[:, None] * steps[None, :]
+    label = np.broadcast_to(point.label[:, None], tau.shape)
+    hp, ha, q = curves.at(label, tau)
+    weighted = q * (NU_REF * np.expm1(tau))
+    dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
+    x = np.clip((hp - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
+    cell = x.astype(np.intp)
+    frac = x - cell
+    rows = np.arange(hp.shape[0])[:, None]
+    low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
+    ratio = np.exp(low + frac * (high - low))
+    if scenario.atmosphere == "msis":
+        from orbit_env.decay.chunked import log_density_slope_per_m
+        from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
+
+        atmosphere = curves.model.atmosphere
+        assert isinstance(atmosphere, MsisAtmosphere)
+        density_slope = np.interp(hp, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
+        ratio = orbit_ratio(ratio, (high - low) / dh, density_slope, hp, ha)
+    if scenario.rotating_atmosphere:
+        p, e = elements_from_heights(hp, ha)
+        r_p = EARTH_RADIUS_M + hp
+        v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
+        wind = EARTH_ROTATION_RAD_S * r_p
+        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))[:, None]
+        ratio = ratio * ((v_p - wind * cos_i) / (v_p - wind * np.cos(np.radians(reference_deg)))) ** 2
+    inverse = 1.0 / ratio
+    time_gcs = np.sum(np.diff(weighted, axis=1) * 0.5 * (inverse[:, 1:] + inverse[:, :-1]), axis=1)
+    return np.asarray(time_gcs / (G0_M_S2 * drag_parameter_m2_kg * scenario.density_scale) / SECONDS_PER_DAY)
 
 
 def _fmt(value: float) -> str:

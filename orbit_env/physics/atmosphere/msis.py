@@ -231,6 +231,55 @@ def mean_density_over_days_kg_m3(
     return rho.mean(axis=(0, 1))
 
 
+def mean_density_over_inclinations_kg_m3(
+    altitude_m: ArrayLike,
+    f107_sfu: float,
+    f107a_sfu: float,
+    ap: float,
+    inclinations_deg: ArrayLike,
+    ascending_node_local_time_h: float | None = None,
+    *,
+    latitude_nodes: int = LATITUDE_NODES,
+    local_time_nodes: int = LOCAL_TIME_NODES,
+    season_nodes: int = SEASON_NODES,
+) -> FloatArray:
+    """`mean_density_kg_m3` (averaged over the year) at several inclinations, in one NRLMSIS call.
+
+    Returns an array (inclinations, altitudes): row k is `mean_density_kg_m3` at
+    ``inclinations_deg[k]`` with the same nodes. One call for all rows: NRLMSIS's
+    cost is per point, but a catalogue spread over inclinations should not pay
+    ``pymsis``'s set-up once per inclination.
+    """
+    msis = require_pymsis()
+    alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
+    inclinations = np.atleast_1d(np.asarray(inclinations_deg, dtype=np.float64))
+    samples = [
+        orbit_samples(float(i), ascending_node_local_time_h, latitude_nodes, local_time_nodes) for i in inclinations
+    ]
+    lat = np.stack([s[0] for s in samples])  # (inclinations, samples)
+    lon = np.mod((np.stack([s[1] for s in samples]) - _UT_HOURS) * 15.0, 360.0)
+    days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
+    shape = (inclinations.size, days.size, lat.shape[1], alt.size)
+    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
+    dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[None, :, None, None], shape).ravel()
+    lats = np.broadcast_to(lat[:, None, :, None], shape).ravel()
+    lons = np.broadcast_to(lon[:, None, :, None], shape).ravel()
+    alts_km = np.broadcast_to(geodetic_altitude_m(alt[None, None, None, :], lat[:, None, :, None]) / 1e3, shape).ravel()
+    ones = np.ones(alts_km.size)
+    out = msis.calculate(
+        dates,
+        lons,
+        lats,
+        alts_km,
+        f107s=f107_sfu * ones,
+        f107as=f107a_sfu * ones,
+        aps=np.full((alts_km.size, 7), float(ap)),
+        version=2.1,
+    )
+    rho = np.asarray(out[..., 0], dtype=np.float64).reshape(shape)
+    return rho.mean(axis=(1, 2))
+
+
 @lru_cache(maxsize=256)
 def _cached_log_density_table(*conditions: float | None) -> FloatArray:
     """`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""

@@ -1,0 +1,102 @@
+"""An NRLMSIS catalogue spread over inclinations against one at a single inclination: cost and accuracy, one run.
+
+Run: python benchmarks/bench_catalogue.py [--rows N] [--repeats R] [--no-exact] [--rotating]
+(needs pymsis; the exact reference builds a curve family per 1-degree group, about 90 s).
+
+The same 10^4 near-circular orbits (perigee 200-1000 km, apogee up to 100 km higher:
+the one-family path's domain, ``SPREAD_MAX_SPAN_M``; ballistic loads 20-200 kg/m^2)
+twice: every row at 51.6 deg, and whole-degree inclinations uniform over 0-98 deg
+(whole degrees, so that the 1-degree groups below see the rows' own inclinations).
+Each is timed cold (no disk cache, in-process caches cleared: the NRLMSIS profile and
+the curve family are built as in a first run), from the CSV file to the results
+file, median of the repeats. Then the spread catalogue's lifetimes by the
+one-family path (a density ratio along each decay) against a family per 1-degree
+group (``exact_groups=True``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from orbit_env import cache
+from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
+from orbit_env.analysis.scenario import Scenario
+from orbit_env.decay.chunked import cached_curves, log_density_slope_per_m
+from orbit_env.decay.solar import ConstantActivity
+from orbit_env.physics.atmosphere.msis import _cached_log_density_table
+
+C_X = 2.2
+
+
+def write_catalogue(path: Path, rows: int, inclination_deg: np.ndarray | float, seed: int = 3) -> None:
+    rng = np.random.default_rng(seed)
+    perigee = rng.uniform(200.0, 1000.0, rows)
+    apogee = perigee + rng.uniform(0.0, 100.0, rows)
+    load = rng.uniform(20.0, 200.0, rows)
+    inclination = np.broadcast_to(inclination_deg, (rows,))
+    lines = ["perigee_km,apogee_km,mass_per_area_kg_m2,inclination_deg"]
+    lines += [f"{p:.3f},{a:.3f},{m:.3f},{i:.3f}" for p, a, m, i in zip(perigee, apogee, load, inclination, strict=True)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def run(path: Path, out: Path, scenario: Scenario, *, exact_groups: bool = False) -> tuple[float, np.ndarray, int]:
+    _cached_log_density_table.cache_clear()
+    cached_curves.cache_clear()
+    log_density_slope_per_m.cache_clear()
+    start = time.perf_counter()
+    rows, hp, ha, c, inc, status = read_batch(path, C_X, C_X / 100.0, 51.6)
+    records, summary = batch_lifetimes(
+        rows, hp, ha, c, inc, status, scenario, progress=False, exact_groups=exact_groups
+    )
+    write_records(out, records)
+    elapsed = time.perf_counter() - start
+    days = np.array([float(r["days"]) if r["days"] else np.nan for r in records])
+    return elapsed, days, summary.groups
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rows", type=int, default=10_000)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--no-exact", action="store_true", help="skip the 1-degree reference (90 s)")
+    parser.add_argument("--rotating", action="store_true", help="co-rotating air")
+    args = parser.parse_args()
+    cache.disable()
+    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0), rotating_atmosphere=args.rotating)
+    with tempfile.TemporaryDirectory() as folder:
+        one, spread, out = Path(folder, "one.csv"), Path(folder, "spread.csv"), Path(folder, "out.csv")
+        write_catalogue(one, args.rows, 51.6)
+        write_catalogue(spread, args.rows, np.random.default_rng(11).integers(0, 99, args.rows).astype(float))
+        times_one, times_spread = [], []
+        for _ in range(args.repeats):  # interleaved: the machine's load moves both alike
+            t, _, groups_one = run(one, out, scenario)
+            times_one.append(t)
+            t, days, groups_spread = run(spread, out, scenario)
+            times_spread.append(t)
+        t_one, t_spread = statistics.median(times_one), statistics.median(times_spread)
+        air = "co-rotating" if args.rotating else "still"
+        print(f"{args.rows} rows, NRLMSIS F10.7 150, Ap 15, {air} air, cold, median of {args.repeats}")
+        print(f"  one inclination (51.6 deg)       {t_one:7.2f} s   {groups_one} curve family")
+        print(f"  spread over 0-98 deg             {t_spread:7.2f} s   {groups_spread} curve family")
+        print(f"  ratio spread / one inclination   {t_spread / t_one:7.2f}")
+        if not args.no_exact:
+            t_exact, exact, groups = run(spread, out, scenario, exact_groups=True)
+            error = days / exact - 1.0
+            finite = np.isfinite(error)
+            abs_error = np.abs(error[finite])
+            print(f"  a family per 1-degree group      {t_exact:7.2f} s   {groups} curve families")
+            print(
+                f"  one family + ratio vs 1-degree groups ({finite.sum()} rows): median |error| "
+                f"{np.median(abs_error):.3%}, 99th percentile {np.percentile(abs_error, 99):.3%}, "
+                f"max {abs_error.max():.3%} (mean {np.mean(error[finite]):+.3%})"
+            )
+
+
+if __name__ == "__main__":
+    main()
