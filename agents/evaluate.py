@@ -276,6 +276,29 @@ def _space_text(space: Any) -> str:
     return f"Discrete({space.n})" if hasattr(space, "n") else f"Box{tuple(space.shape)}"
 
 
+class ActingOnly:
+    """Stands in for the optimizer of a model loaded to act (`load_model`): it cannot train."""
+
+    def __init__(self, params: Any, lr: float = 0.0, **kwargs: Any) -> None:
+        self.param_groups: list[Any] = []
+
+    def load_state_dict(self, state: Any, strict: bool = True) -> None:
+        """The saved optimizer state is not needed to act."""
+
+    def state_dict(self) -> dict[str, Any]:
+        """Nothing to save."""
+        return {}
+
+    def step(self, *args: Any, **kwargs: Any) -> None:
+        """Refused: a model loaded to act does not train."""
+        raise RuntimeError(
+            "this model was loaded to act (orbit_env.agents.evaluate.load_model); load it with SB3 to train"
+        )
+
+    def zero_grad(self, *args: Any, **kwargs: Any) -> None:
+        """Nothing to clear."""
+
+
 def load_model(
     env_id: str, model_path: str | Path | None = None, warn: Callable[[str], None] | None = None
 ) -> tuple[str, Predictor] | None:
@@ -285,6 +308,9 @@ def load_model(
     The file must exist and load; its observation and action spaces must be the
     environment's; a model that records another environment (``orbit-env train``
     records it) gets a warning through ``warn``, as does one that records none.
+
+    The model is loaded to act, not to train: its optimizer is `ActingOnly`
+    (a torch optimizer would import torch's compiler, 1.4 s of CPU).
 
     It sets torch to one intra-op thread (``torch.set_num_threads(1)``): the
     evaluation's batches (up to 1000 observations of 7 through layers of 64) are
@@ -308,10 +334,13 @@ def load_model(
         raise ValueError(f"no model at {path}")
     algorithm = model_algorithm(path)
     import torch
+    from stable_baselines3.common.save_util import load_from_zip_file
 
     torch.set_num_threads(1)
     try:
-        model = _algorithm_class(algorithm).load(path, device="cpu")
+        data, _, _ = load_from_zip_file(path, device="cpu")
+        kwargs = {**(data or {}).get("policy_kwargs", {}), "optimizer_class": ActingOnly}
+        model = _algorithm_class(algorithm).load(path, device="cpu", custom_objects={"policy_kwargs": kwargs})
     except Exception as error:  # a damaged file fails in many ways: one line names it
         raise ValueError(
             f"{path} does not load as a {algorithm.upper()} model: {type(error).__name__}: {error}"
@@ -322,7 +351,7 @@ def load_model(
         ("observation", base.observation_space, model.observation_space),
     ):
         if (
-            type(mine) is not type(theirs)
+            not (isinstance(mine, type(theirs)) or isinstance(theirs, type(mine)))  # a subclass is the same space
             or getattr(mine, "n", None) != getattr(theirs, "n", None)
             or (mine.shape != theirs.shape)
         ):
