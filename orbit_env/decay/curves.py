@@ -199,6 +199,39 @@ class _Grid:
         # The cell's coefficients as Python floats in one call (item() per number costs four times more).
         return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[i * self.ny + j].tolist()]
 
+    def segment_scalar(self, x: float, y: float) -> tuple[list[float], float]:
+        """`segments` for one point, in plain floats: the list [j, bases..., slopes...], and ty.
+
+        The same operations in the same order as `segments`, so the single
+        environment's orbit follows the same lines as a vector environment's, bit for bit.
+        """
+        fx = min(max(x * self.x_scale - self.x_offset, 0.0), self.x_top)
+        fy = y * self.y_scale
+        if self.y_offset:
+            fy -= self.y_offset
+        fy = min(max(fy, 0.0), self.y_top)
+        i = int(fx)
+        tx = fx - i
+        j = int(fy)
+        cell = self.cells[i * self.ny + j].tolist()
+        bases = [c1 * tx + c0 for c0, c1, _, _ in cell]
+        slopes = [c3 * tx + c2 for _, _, c2, c3 in cell]
+        return [float(j), *bases, *slopes], fy - j
+
+    def on_segment_scalar(self, segment: list[float], x: float, y: float) -> float:
+        """`on_segments` for one point: how far across its cell ``y`` is, ty.
+
+        ``segment`` (from `segment_scalar`) is renewed in place if ``y`` has left
+        its cell; the values are then ``slope * ty + base`` (`_heights_along`).
+        """
+        fy = y * self.y_scale
+        if self.y_offset:
+            fy -= self.y_offset
+        ty = fy - segment[0]
+        if not 0.0 <= ty <= 1.0:  # left its cell (or a stale segment, j = -inf)
+            segment[:], ty = self.segment_scalar(x, y)
+        return ty
+
 
 def _spline_rows(x: FloatArray, y: FloatArray, counts: NDArray[np.intp], query: FloatArray) -> FloatArray:
     """Cubic splines through the knots of each row, at the query points: scipy's ``CubicSpline`` in numpy.
@@ -291,6 +324,26 @@ def _heights(mu: FloatArray, b0: FloatArray, b1: FloatArray, q: FloatArray) -> t
     apogee -= rp
     apogee -= EARTH_RADIUS_M
     return hp, apogee, q
+
+
+def _heights_scalar(mu: float, b0: float, b1: float, q: float) -> tuple[float, float, float]:
+    """`_heights` for one orbit, in plain floats: the same operations in the same order."""
+    hp = max(b0, REENTRY_ALTITUDE_M)
+    one_minus_e = 1.0 - math.exp(b1 + mu)
+    rp = hp + EARTH_RADIUS_M
+    return hp, (rp + rp) / one_minus_e - rp - EARTH_RADIUS_M, q
+
+
+def _heights_along(mu: float, segment: list[float], ty: float) -> tuple[float, float, float]:
+    """`_heights` of table B's values at ``ty`` across one orbit's kept cell (`_Grid.segment_scalar`).
+
+    The arithmetic of ``_heights(mu, *_Grid.along(...))``, unrolled for table B's three values.
+    """
+    _, hp_base, y_base, q_base, hp_slope, y_slope, q_slope = segment
+    hp = max(hp_slope * ty + hp_base, REENTRY_ALTITUDE_M)
+    one_minus_e = 1.0 - math.exp(y_slope * ty + y_base + mu)
+    rp = hp + EARTH_RADIUS_M
+    return hp, (rp + rp) / one_minus_e - rp - EARTH_RADIUS_M, q_slope * ty + q_base
 
 
 @dataclass(frozen=True)
@@ -525,7 +578,14 @@ class UniversalCurves:
         lines the three values follow across it replaces a gather per orbit and
         step by two operations per value. Locate anew the orbits whose label
         changed (a burn); cell changes are handled by ``advance_heights``.
+
+        For two floats (one orbit): floats, and the cell as a list (`_Grid.segment_scalar`).
         """
+        if isinstance(perigee_m, float) and isinstance(apogee_m, float):
+            label_s, tau_s = self._label_tau(perigee_m, apogee_m)
+            segment, ty_s = self._table_b.segment_scalar(label_s, tau_s)
+            hp_s, ha_s, q_s = _heights_along(label_s, segment, ty_s)
+            return CurvePoint(label=label_s, tau=tau_s, mean_period_s=q_s), hp_s, ha_s, segment
         label, tau = self._label_tau(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
         segments, ty = self._table_b.segments(label, tau)
         perigee, apogee, q = _heights(label, *self._table_b.along(segments, ty))
@@ -561,11 +621,7 @@ class UniversalCurves:
 
     def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
         """`at` for one orbit, in plain floats (the arithmetic of `_heights`)."""
-        b0, b1, b2 = self._table_b.values_scalar(mu, tau)
-        hp = max(b0, REENTRY_ALTITUDE_M)
-        e = math.exp(b1 + mu)
-        rp = EARTH_RADIUS_M + hp
-        return hp, rp * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M, b2
+        return _heights_scalar(mu, *self._table_b.values_scalar(mu, tau))
 
     def _after(self, point: CurvePoint, dnu: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The (nu, tau) reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
@@ -591,12 +647,17 @@ class UniversalCurves:
         ``segments`` (from `locate_segments`, for these orbits' labels) the
         interpolation uses and updates them in place.
         """
-        if segments is None and isinstance(dnu, float) and isinstance(point.tau, float):
-            # One orbit (the single environment, every step): _after and at in plain floats.
+        if isinstance(dnu, float) and isinstance(point.tau, float):
+            # One orbit (the single environment, every step): _after and at in plain floats, on its
+            # kept cell if it has one (a list from locate_segments).
             nu_s = max(point.nu - dnu, 0.0)
             tau_s = math.log1p(nu_s * (1.0 / NU_REF))
-            label_s = float(point.label)
-            hp_s, ha_s, q_s = self._at_scalar(label_s, tau_s)
+            label_s = point.label
+            if segments is None:
+                hp_s, ha_s, q_s = self._at_scalar(label_s, tau_s)
+            else:
+                ty_s = self._table_b.on_segment_scalar(segments, label_s, tau_s)
+                hp_s, ha_s, q_s = _heights_along(label_s, segments, ty_s)
             return CurvePoint._with_nu(label_s, tau_s, q_s, nu_s), hp_s, ha_s
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)

@@ -33,7 +33,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from gymnasium import spaces
@@ -106,6 +106,32 @@ RESET_OPTIONS = ORBIT_OPTIONS + SATELLITE_OPTIONS
 _UNSIGNED = {1: np.uint8, 2: np.uint16, 4: np.uint32, 8: np.uint64}  # by item size: the actions' range check
 
 
+class UniformBox(spaces.Box):
+    """A float `gymnasium.spaces.Box` bounded on every side, whose ``sample`` is one uniform draw.
+
+    Gymnasium's ``Box.sample`` sorts the coordinates into bounded, half-bounded and
+    unbounded ones with a dozen numpy calls (about 20 us, three CartPole steps). For a
+    float box bounded on every side that comes down to one uniform draw, made here
+    directly: the same numbers from the same generator (``tests/test_envs.py``
+    compares them with ``Box.sample``'s). Bounds equal on every coordinate are
+    passed as two floats, with which numpy's ``uniform`` is five times faster
+    than with arrays.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        assert self.is_bounded("both") and self.dtype.kind == "f", "a float box bounded on every side"
+        low, high = np.unique(self.low), np.unique(self.high)
+        self._bounds = (float(low[0]), float(high[0])) if low.size == high.size == 1 else (self.low, self.high)
+
+    def sample(self, mask: None = None, probability: None = None) -> NDArray[Any]:
+        """A point drawn uniformly in the box (masks are Box's: unsupported)."""
+        if mask is not None or probability is not None:
+            return super().sample(mask, probability)
+        low, high = self._bounds
+        return self.np_random.uniform(low, high, self.shape).astype(self.dtype)
+
+
 @dataclass(frozen=True)
 class Task:
     """The parameters of one orbit-raising task: satellite and mission, density knowledge, action kind.
@@ -162,7 +188,7 @@ class Task:
     def action_space(self) -> spaces.Space:
         """Discrete(len(burn_sizes_m_s)), or Box([-1], [1]) for the continuous variant."""
         if self.continuous:
-            return spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+            return UniformBox(-1.0, 1.0, shape=(1,), dtype=np.float32)
         return spaces.Discrete(len(self.config.burn_sizes_m_s))
 
     def requested_dv(self, action: Any) -> float:
@@ -177,6 +203,10 @@ class Task:
             raise ValueError(
                 f"action={action!r} is invalid; allowed: an integer in [0, {len(sizes) - 1}] (burns of {sizes} m/s)"
             )
+        if isinstance(action, np.ndarray) and action.shape == (1,) and action.dtype.kind == "f":
+            one = float(action[0])  # the action space's own form, without numpy calls on a 1-element array
+            if -1.0 <= one <= 1.0:  # False for NaN
+                return self.config.max_burn_m_s * max(one, 0.0)
         value = np.asarray(action, dtype=np.float64) if not isinstance(action, (str, bytes)) else np.array(np.nan)
         if value.shape not in ((), (1,)) or not (np.isfinite(value).all() and (np.abs(value) <= 1.0).all()):
             raise ValueError(f"action={action!r} is invalid; allowed: one number in [-1, 1]")
@@ -276,16 +306,16 @@ class TaskState:
     """
 
     # point: the CurvePoint of (label, tau, period_s, nu), kept by the task functions that move the
-    # orbit so that a step builds no second one.
-    __slots__ = (*STATE_FIELDS, "point")
-    #: Only a batch keeps the orbits' cells of the curves' table.
-    segments: ClassVar[None] = None
+    # orbit so that a step builds no second one. segments: the orbit's cell of the curves' table B,
+    # a list (UniversalCurves.locate_segments), as a batch keeps its rows' cells.
+    __slots__ = (*STATE_FIELDS, "point", "segments")
 
     def copy(self) -> TaskState:
         """An independent copy."""
         other = TaskState()
         for name in self.__slots__:
             setattr(other, name, getattr(self, name))
+        other.segments = list(self.segments)  # renewed in place by a coast
         return other
 
 
@@ -333,10 +363,6 @@ class BatchState:
             index = np.flatnonzero(index)
         return BatchState(self.data.take(index, axis=1))
 
-    def rows(self, index: NDArray[np.intp]) -> SatelliteRows:
-        """The satellites at ``index``, read and written in place (no copy): a subset that burns."""
-        return SatelliteRows(self, index)
-
     def put(self, index: Any, other: BatchState) -> None:
         """Write ``other``'s satellites into the places ``index``."""
         self.data[:, index] = other.data
@@ -346,45 +372,7 @@ class BatchState:
         return BatchState(self.data.copy())
 
 
-class SatelliteRows:
-    """Some satellites of a `BatchState`, in place: reading a field gathers it, assigning scatters it.
-
-    For the few satellites that burn in a step of thousands: the task functions run
-    on them as on a batch, and only the fields they touch are gathered and written.
-    """
-
-    __slots__ = ("_index", "_state")
-
-    def __init__(self, state: BatchState, index: NDArray[np.intp]) -> None:
-        self._state = state
-        self._index = index
-
-    @property
-    def segments(self) -> FloatArray:
-        """The satellites' cells of the curves' table (a copy)."""
-        return self._state.segments[:, self._index]
-
-    @segments.setter
-    def segments(self, value: FloatArray) -> None:
-        self._state.segments[:, self._index] = value
-
-
-def _field(name: str) -> property:
-    def get(rows: SatelliteRows) -> FloatArray:
-        return rows._state.__dict__[name].take(rows._index)
-
-    def put(rows: SatelliteRows, value: Any) -> None:
-        rows._state.__dict__[name][rows._index] = value
-
-    return property(get, put, doc=f"{name} of the satellites (read: a copy; assigned: written in place).")
-
-
-for _name in STATE_FIELDS:
-    setattr(SatelliteRows, _name, _field(_name))
-del _name
-
-
-AnyState = TaskState | BatchState | SatelliteRows
+AnyState = TaskState | BatchState
 
 
 # ---------------------------------------------------------------------------------
@@ -394,6 +382,8 @@ AnyState = TaskState | BatchState | SatelliteRows
 
 def delta_v_left_m_s(mass_kg: ArrayLike, dry_mass_kg: ArrayLike, exhaust_velocity_m_s: ArrayLike) -> FloatArray:
     """Delta-v the propellant on board still gives, Tsiolkovsky: v_e ln(m / m_dry) [m/s]."""
+    if isinstance(mass_kg, float) and isinstance(dry_mass_kg, float) and isinstance(exhaust_velocity_m_s, float):
+        return exhaust_velocity_m_s * math.log(mass_kg / dry_mass_kg)  # one satellite: no numpy on floats
     return exhaust_velocity_m_s * np.log(np.divide(mass_kg, dry_mass_kg))
 
 
@@ -457,6 +447,8 @@ def density_scale_at(
     base_scale: ArrayLike, amplitude: float, period_days: float, phase_rad: ArrayLike, time_days: ArrayLike
 ) -> FloatArray:
     """Density scale s(t) = s0 exp(A sin(2 pi t / T + phi)) of `DensityConfig`."""
+    if isinstance(base_scale, float) and isinstance(phase_rad, float) and isinstance(time_days, float):
+        return base_scale * math.exp(amplitude * math.sin(TWO_PI * time_days / period_days + phase_rad))
     return np.asarray(base_scale) * np.exp(amplitude * np.sin(TWO_PI * np.asarray(time_days) / period_days + phase_rad))
 
 
@@ -530,6 +522,10 @@ def resolve_options(
         raise ValueError(f"unknown reset option(s) {unknown}; allowed: {list(RESET_OPTIONS)}")
     merged: dict[str, Any] = {name: getattr(config, name) for name in SATELLITE_OPTIONS}
     merged.update(drawn)
+    if not options:
+        # The config's satellite and draws from its ranges, both checked when the config was made:
+        # every automatic reset, where the checks would cost ten times the rest.
+        return merged
     shape = () if size is None else (size,)
     for name, value in options.items():
         array = np.asarray(value, dtype=np.float64) if not isinstance(value, (str, bytes)) else None
@@ -689,11 +685,9 @@ def place(task: Task, state: AnyState, perigee_m: Any, apogee_m: Any) -> None:
     observed decay of a step is never the locate-and-read-back round trip's
     interpolation error (``UniversalCurves.locate_heights``).
     """
-    curves = task.curves
     if isinstance(state, TaskState):
-        point, state.perigee_m, state.apogee_m = curves.locate_heights(float(perigee_m), float(apogee_m))
-    else:
-        point, state.perigee_m, state.apogee_m, state.segments = curves.locate_segments(perigee_m, apogee_m)
+        perigee_m, apogee_m = float(perigee_m), float(apogee_m)
+    point, state.perigee_m, state.apogee_m, state.segments = task.curves.locate_segments(perigee_m, apogee_m)
     state.label = point.label
     state.tau = point.tau
     state.nu = point.nu
@@ -718,13 +712,6 @@ def place_on_curves(task: Task, state: BatchState, label: FloatArray, tau: Float
     state.segments[0] = STALE_SEGMENT
 
 
-def _point(state: AnyState) -> CurvePoint:
-    """The state's place on the curves, nu known (no expm1 of tau)."""
-    if isinstance(state, TaskState):
-        return state.point
-    return CurvePoint._with_nu(state.label, state.tau, state.period_s, state.nu)
-
-
 def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
     """Fire at perigee where asked and able: spend the mass, relocate the orbit; return the burns made [m/s].
 
@@ -747,19 +734,21 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s))  # asked to burn, and able to
     if asked.size:
         requested = requested_dv_m_s[asked] if np.ndim(requested_dv_m_s) else requested_dv_m_s
-        asking = state.rows(asked)
+        # The few that burn, gathered once, moved as a batch of their own, and written back once.
+        firing = state.take(asked)
         dv, apogee_m, mass_kg = perigee_burn(
-            asking.perigee_m, asking.apogee_m, asking.mass_kg, asking.dry_mass_kg, asking.exhaust_m_s, requested
+            firing.perigee_m, firing.apogee_m, firing.mass_kg, firing.dry_mass_kg, firing.exhaust_m_s, requested
         )
         fired = dv > 0.0
         if not fired.all():
             asked, dv, apogee_m, mass_kg = asked[fired], dv[fired], apogee_m[fired], mass_kg[fired]
+            firing = firing.take(fired)
         if asked.size:
             made[asked] = dv
-            firing = state.rows(asked)
             firing.mass_kg = mass_kg
             update_satellite(task, firing)
             place(task, firing, firing.perigee_m, apogee_m)
+            state.put(asked, firing)
     return made
 
 
@@ -781,24 +770,26 @@ def coast(task: Task, state: AnyState, steps: Any = 1.0) -> Any:
     in one jump are the sum of single steps' days (nu falls by the same K g c s each
     step), up to round-off. The drops are those of the whole coast.
     """
+    single = isinstance(state, TaskState)
     weighted_s = state.period_s * state.nu  # W = q nu, as CurvePoint.weighted_s (not cached: cheaper)
     revolutions = task.config.revolutions_per_step * steps
-    after, perigee_m, apogee_m = task.curves.advance_heights(
-        _point(state), revolutions * state.nu_per_rev, state.segments
-    )
+    # The state's place on the curves, nu known (no expm1 of tau).
+    point = state.point if single else CurvePoint._with_nu(state.label, state.tau, state.period_s, state.nu)
+    after, perigee_m, apogee_m = task.curves.advance_heights(point, revolutions * state.nu_per_rev, state.segments)
     days = (weighted_s - after.mean_period_s * after.nu) / (state.nu_per_rev * SECONDS_PER_DAY)
-    # The drops as heights before less heights after, written in place on a batch's rows.
-    state.perigee_drop_m = state.perigee_m
-    state.perigee_drop_m -= perigee_m
-    state.apogee_drop_m = state.apogee_m
-    state.apogee_drop_m -= apogee_m
+    # The drops: heights before less heights after (on a batch's rows, written in place).
+    if single:
+        state.perigee_drop_m = state.perigee_m - perigee_m
+        state.apogee_drop_m = state.apogee_m - apogee_m
+        state.point = after
+    else:
+        np.subtract(state.perigee_m, perigee_m, out=state.perigee_drop_m)
+        np.subtract(state.apogee_m, apogee_m, out=state.apogee_drop_m)
     state.perigee_m = perigee_m
     state.apogee_m = apogee_m
     state.tau = after.tau
     state.nu = after.nu
     state.period_s = after.mean_period_s
-    if isinstance(state, TaskState):
-        state.point = after
     state.time_days += days  # in place on a batch's rows
     state.steps += steps
     return days
