@@ -23,15 +23,18 @@ With NRLMSIS the profile depends on the inclination (and in co-rotating air the
 drag does): rows are grouped by inclination rounded to ``INCLINATION_STEP_DEG``
 (1 deg moves a lifetime by about 0.5%, measured at 50 deg and 400 km, so rounding
 costs at most 0.25%). Up to ``MAX_FAMILIES`` groups get a curve family each (0.9 s
-to build). A catalogue spread over more groups takes one family, that of its most
-common inclination, and each row's own inclination as a density multiplier along
-its decay: the ratio of NRLMSIS at the row's inclination to the family's (computed
-every ``ANCHOR_STEP_DEG`` in one NRLMSIS call and interpolated in inclination,
-weighted over the orbit as drag weights it, `orbit_env.decay.chunked.orbit_ratio`),
-and of the co-rotating air's drag, integrated over the decay: the time is
-Int dW / (g c s) along the family's curve. Its error against a family per 1-degree
-group is measured in ``benchmarks/bench_msis.py`` (docs/validation-modern.md). The
-paper's and the exponential law in still air do not depend on the inclination: one group.
+to build). In a catalogue spread over more groups, the near-circular rows (apogee at
+most ``SPREAD_MAX_SPAN_M`` above perigee) take one family, that of their most common
+inclination, and each row's own inclination as a density multiplier along its decay:
+the ratio of NRLMSIS at the row's inclination to the family's (computed every
+``ANCHOR_STEP_DEG`` in one NRLMSIS call and interpolated in inclination, weighted over
+the orbit as drag weights it, `orbit_env.decay.chunked.orbit_ratio`), and of the
+co-rotating air's drag; the time is Int dW / (g c s) along the family's curve. On 10^4
+rows over 0-98 deg this costs 1.7 times one inclination and stays within 0.4% of a
+family per 1-degree group (``benchmarks/bench_catalogue.py``, docs/validation-modern.md
+section 7); wider orbits, a disposal rule and the time-stepped path keep a family per
+group. The paper's and the exponential law in still air do not depend on the
+inclination: one group.
 """
 
 from __future__ import annotations
@@ -73,7 +76,7 @@ INCLINATION_STEP_DEG = 1.0
 #: A catalogue with more inclination groups than this takes one curve family and a density ratio.
 MAX_FAMILIES = 2
 #: Widest orbit [m] (apogee - perigee height) on that path: the ratio is one multiplier for the perigee
-#: and the eccentricity decay alike, which holds for near-circular orbits (error measured in the module docstring).
+#: and the eccentricity decay alike, which holds for near-circular orbits (errors by width: docs/validation-modern.md, 7).
 SPREAD_MAX_SPAN_M = 100e3
 #: Inclinations [deg] at which a spread catalogue's NRLMSIS ratio is computed (interpolated between).
 ANCHOR_STEP_DEG = 10.0
