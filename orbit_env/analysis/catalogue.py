@@ -76,7 +76,7 @@ INCLINATION_STEP_DEG = 1.0
 #: A catalogue with more inclination groups than this takes one curve family and a density ratio.
 MAX_FAMILIES = 2
 #: Widest orbit [m] (apogee - perigee height) on that path: the ratio is one multiplier for the perigee
-#: and the eccentricity decay alike, which holds for near-circular orbits (errors by width: docs/validation-modern.md, 7).
+#: and the eccentricity decay alike, which holds for near-circular orbits (errors by width: validation-modern.md, 7).
 SPREAD_MAX_SPAN_M = 100e3
 #: Inclinations [deg] at which a spread catalogue's NRLMSIS ratio is computed (interpolated between).
 ANCHOR_STEP_DEG = 10.0
