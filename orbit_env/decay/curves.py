@@ -127,17 +127,15 @@ class _Grid:
         """The k tables at the points (x, y) (arrays that broadcast against each other)."""
         cell, tx, _, ty = self._cells(x, y)
         txy = tx * ty
-        out = []
-        for m in range(self.k):
-            c = cell[..., m, :]
-            value = c[..., 1] * tx
-            value += c[..., 0]
-            term = c[..., 2] * ty
-            value += term
-            term = c[..., 3] * txy
-            value += term
-            out.append(value)
-        return out
+        # Every table in each operation (the last axis): the calls of one table, not of k.
+        tx, ty, txy = tx[..., None], ty[..., None], txy[..., None]
+        value = cell[..., 1] * tx
+        value += cell[..., 0]
+        term = cell[..., 2] * ty
+        value += term
+        term = cell[..., 3] * txy
+        value += term
+        return [value[..., m] for m in range(self.k)]
 
     def segments(self, x: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Per point, the y cell it lies in and, per table, the line the interpolant follows across it at x.
@@ -148,23 +146,23 @@ class _Grid:
         c2 + c3 tx; and ty, where y is in its cell. `along` evaluates them.
         """
         cell, tx, j, ty = self._cells(x, y)
-        out = np.empty((1 + 2 * self.k, *tx.shape))
+        assert tx.ndim == 1, "segments of a 1-d array of points"
+        k = self.k
+        out = np.empty((1 + 2 * k, tx.size))
         out[0] = j
-        for m in range(self.k):
-            np.multiply(cell[..., m, 1], tx, out=out[1 + m])
-            out[1 + m] += cell[..., m, 0]
-            np.multiply(cell[..., m, 3], tx, out=out[1 + self.k + m])
-            out[1 + self.k + m] += cell[..., m, 2]
+        bases, slopes = out[1 : 1 + k], out[1 + k :]
+        cell = cell.transpose(1, 2, 0)  # (k, 4, n): every table in each operation
+        np.multiply(cell[:, 1], tx, out=bases)
+        bases += cell[:, 0]
+        np.multiply(cell[:, 3], tx, out=slopes)
+        slopes += cell[:, 2]
         return out, ty
 
     def along(self, segments: FloatArray, ty: FloatArray) -> list[FloatArray]:
         """The k tables at ``ty`` of the way across each point's cell (see `segments`)."""
-        out = []
-        for m in range(self.k):
-            value = segments[1 + self.k + m] * ty
-            value += segments[1 + m]
-            out.append(value)
-        return out
+        values = segments[1 + self.k :] * ty  # every table in one operation: (k, n)
+        values += segments[1 : 1 + self.k]
+        return list(values)
 
     def on_segments(self, segments: FloatArray, x: FloatArray, y: FloatArray) -> list[FloatArray]:
         """`values` at (x, y) for points whose x has not changed since ``segments`` was made.
