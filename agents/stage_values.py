@@ -15,11 +15,13 @@ stage 0.2 s on one core, against 4.0 s and 1.4 s for zlib at its fastest level
 (99 MB), which is why the DP depends on ``zstandard``. With a keyframe every
 ``KEYFRAME_STAGES`` stages, the default task's solution takes 122 MB.
 
-A stage is read by decompressing from the keyframe at or below it; the stages
-decoded on the way are kept (the last two runs of stages from a keyframe, each
-at most ``KEYFRAME_STAGES`` stages: about 70 MB on the default grid), so reading
-the stages in either order, or two neighbouring stages at a time (the DP policy
-with a look-ahead of two), decodes each one about once.
+A stage is read from a neighbour read just before it, by adding its increments
+to the stage below or taking the stage above's increments away (V_{k-1} = V_k -
+(V_k - V_{k-1}), exact in integers), or else from the keyframe at or below it.
+Only the last two stages read are kept decoded (about 10 MB on the default grid,
+whatever the number of solutions held, as the oracle's nine), so the DP policy,
+which reads one stage a step in descending order (two with a look-ahead of two),
+decodes one increment a stage.
 """
 
 from __future__ import annotations
@@ -58,7 +60,7 @@ class StageValues:
         self._tails: list[tuple[int, int]] = [(0, 0)]
         self._keyframe = np.zeros(self.sizes.size, dtype=bool)
         self._last: Values | None = None
-        self._runs: list[dict[int, Values]] = []  # the last runs decoded, the newest last
+        self._recent: list[tuple[int, Values]] = []  # the last two stages read, the newest last
         self._compressor = zstandard.ZstdCompressor(level=ZSTD_LEVEL)
         self._decompressor = zstandard.ZstdDecompressor()
 
@@ -113,24 +115,35 @@ class StageValues:
         """The values of ``stage`` (1..stages), uint16 quanta."""
         if not 1 <= stage <= self.stages:
             raise IndexError(f"stage {stage} is not stored; stored: 1 to {self.stages}")
-        for run in self._runs:
-            if stage in run:
-                return run[stage]
-        start = stage
-        while not self._keyframe[start]:
-            start -= 1
-        run = {}
-        values = self._part(self._blobs[start], np.uint16)
-        run[start] = values
-        end = start + 1
-        while end <= self.stages and not self._keyframe[end]:
-            end += 1
-        for k in range(start + 1, end):
-            delta, tail = self._part(self._blobs[k], np.uint8), self._part(self._tails[k], np.uint16)
-            values = np.concatenate([values + delta, tail])
-            run[k] = values
-        self._runs = [*self._runs[-1:], run]
-        return run[stage]
+        for k, values in self._recent:
+            if k == stage:
+                return values
+        values = self._from_recent(stage)
+        if values is None:
+            start = stage
+            while not self._keyframe[start]:
+                start -= 1
+            values = self._part(self._blobs[start], np.uint16)
+            for k in range(start + 1, stage + 1):
+                values = self._up(values, k)
+        self._recent = [*self._recent[-1:], (stage, values)]
+        return values
+
+    def _from_recent(self, stage: int) -> Values | None:
+        """``stage`` from a neighbouring stage read last: one increment added or taken away; None if none is."""
+        for k, values in reversed(self._recent):
+            if k == stage - 1 and not self._keyframe[stage]:
+                return self._up(values, stage)
+            if k == stage + 1 and not self._keyframe[k]:
+                return values[: self.sizes[stage]] - self._part(self._blobs[k], np.uint8)
+        return None
+
+    def _up(self, values: Values, stage: int) -> Values:
+        """Stage ``stage`` from the stage below it (``values``), ``stage`` not a keyframe."""
+        if self._keyframe[stage]:
+            return self._part(self._blobs[stage], np.uint16)
+        delta, tail = self._part(self._blobs[stage], np.uint8), self._part(self._tails[stage], np.uint16)
+        return np.concatenate([values + delta, tail])
 
     def to_arrays(self) -> dict[str, np.ndarray]:
         """The compressed stages as arrays (for the disk cache)."""

@@ -35,7 +35,10 @@ def test_every_stage_comes_back_exactly_in_any_order():
     assert store.stages == count
     # Keyframes where they are due and where an increment does not fit a uint8.
     assert store._keyframe[[1, 7, 11, KEYFRAME_STAGES + 1]].all()
-    for k in [*rng.permutation(count) + 1, *range(count, 0, -1)]:
+    # Random order (from keyframes), descending and ascending (from the neighbour read last),
+    # and two neighbours at a time (the DP policy with a look-ahead of two).
+    pairs = [k for j in range(count, 1, -1) for k in (j, j - 1)]
+    for k in [*rng.permutation(count) + 1, *range(count, 0, -1), *range(1, count + 1), *pairs]:
         np.testing.assert_array_equal(store.get(int(k)), stages[k - 1])
     again = StageValues.from_arrays(store.to_arrays())
     for k in range(1, count + 1):
