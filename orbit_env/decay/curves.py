@@ -669,7 +669,7 @@ class UniversalCurves:
 def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0) -> FloatArray:
     """Universal variable one revolution is worth: dnu/dN = g c s (Eq. 4.1)."""
     if isinstance(drag_parameter_m2_kg, float) and isinstance(density_scale, float):
-        return G0_M_S2 * float(drag_parameter_m2_kg) * float(density_scale)
+        return G0_M_S2 * drag_parameter_m2_kg * density_scale
     return G0_M_S2 * np.multiply(drag_parameter_m2_kg, density_scale, dtype=np.float64)
 
 

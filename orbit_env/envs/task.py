@@ -363,9 +363,20 @@ class BatchState:
             index = np.flatnonzero(index)
         return BatchState(self.data.take(index, axis=1))
 
-    def put(self, index: Any, other: BatchState) -> None:
-        """Write ``other``'s satellites into the places ``index``."""
-        self.data[:, index] = other.data
+    def put(self, index: Any, other: BatchState | FloatArray) -> None:
+        """Write ``other``'s satellites (a `BatchState` or its data) into the places ``index``.
+
+        ``index``: positions (non-negative), a slice or a boolean mask, as numpy takes them.
+        """
+        values = other.data if isinstance(other, BatchState) else other
+        data = self.data
+        if isinstance(index, np.ndarray) and index.ndim == 1 and index.dtype.kind == "i" and data.flags.c_contiguous:
+            # One scatter into the flat array: a third of the time of data[:, index] = values.
+            rows, n = data.shape
+            flat = data.reshape(-1)  # a view: the data is contiguous
+            flat[(np.arange(0, rows * n, n)[:, None] + index).ravel()] = values.ravel()
+        else:
+            data[:, index] = values
 
     def copy(self) -> BatchState:
         """An independent copy."""
@@ -415,7 +426,7 @@ def perigee_burn(
     # Beyond the cap (escape included: its apogee is unbounded): burn only up to the cap.
     # Rare, so the cap's burn is computed only when some burn needs it.
     over = apogee_after > CURVES_MAX_APOGEE_M
-    if np.any(over):
+    if over.any():
         dv_cap = perigee_velocity_m_s(perigee_m, CURVES_MAX_APOGEE_M) - perigee_velocity_m_s(perigee_m, apogee_m)
         dv = np.where(over, np.maximum(np.minimum(dv, dv_cap), 0.0), dv)
         apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
@@ -731,7 +742,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
             place(task, state, state.perigee_m, apogee_m)
         return dv
     made = np.zeros(state.size)
-    asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s))  # asked to burn, and able to
+    asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s) > 0.0)  # asked to burn, and able to
     if asked.size:
         requested = requested_dv_m_s[asked] if np.ndim(requested_dv_m_s) else requested_dv_m_s
         # The few that burn, gathered once, moved as a batch of their own, and written back once.

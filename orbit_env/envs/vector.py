@@ -236,5 +236,5 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             self._pool_next = 0
         take = slice(self._pool_next, self._pool_next + idx.size)
         self._pool_next += idx.size
-        self._state.data[:, idx] = self._pool.data[:, take]
+        self._state.put(idx, self._pool.data[:, take])
         return self._pool_obs[take]
