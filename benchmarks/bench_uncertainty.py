@@ -10,6 +10,9 @@ warmed by one run of the uncertainty command before anything is timed, so both
 commands read the same tables from disk: the ratio is the cost of the samples, not of
 tables built once per machine. ``--cold`` also times both commands from an empty
 cache (each in a folder of its own), where the samples' solar bins are built too.
+The cache's key hashes the package's source, so an edit to it during the run turns
+the warm cache cold: the script counts the tables written during each timing and
+says so if there were any.
 
 Then it prints the uncertainty command's own output with ``--rule 5`` (the band and
 the compliance probability under the 5-year rule).
@@ -26,6 +29,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 EPOCH = "2026-12-01"
 ORBIT = ["--perigee", "550", "--apogee", "550", "--inclination", "97.5", "--rotating-atmosphere"]
@@ -41,6 +45,8 @@ def timed(command: list[str], env: dict[str, str], repeats: int) -> tuple[float,
     work it moves less than the wall time, which waits for the cores.
     """
     walls, cpus = [], []
+    folder = Path(env["ORBIT_ENV_CACHE_DIR"])
+    tables = len(list(folder.iterdir()))
     for _ in range(repeats):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
@@ -48,6 +54,9 @@ def timed(command: list[str], env: dict[str, str], repeats: int) -> tuple[float,
         walls.append(time.perf_counter() - start)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    built = len(list(folder.iterdir())) - tables
+    if built:
+        print(f"   (note: {built} tables written to the disk cache during the next timing: it was not warm)")
     return statistics.median(walls), statistics.median(cpus)
 
 
