@@ -112,7 +112,7 @@ class UniformBox(spaces.Box):
     Gymnasium's ``Box.sample`` sorts the coordinates into bounded, half-bounded and
     unbounded ones with a dozen numpy calls (about 20 us, three CartPole steps). For a
     float box bounded on every side that comes down to one uniform draw, made here
-    directly: the same numbers from the same generator (``tests/test_envs.py``
+    directly: the same numbers from the same generator (``tests/test_fast_paths.py``
     compares them with ``Box.sample``'s). Bounds equal on every coordinate are
     passed as two floats, with which numpy's ``uniform`` is five times faster
     than with arrays.
@@ -204,7 +204,7 @@ class Task:
                 f"action={action!r} is invalid; allowed: an integer in [0, {len(sizes) - 1}] (burns of {sizes} m/s)"
             )
         if isinstance(action, np.ndarray) and action.shape == (1,) and action.dtype.kind == "f":
-            one = float(action[0])  # the action space's own form, without numpy calls on a 1-element array
+            one = action.item()  # the action space's own form, without numpy calls on a 1-element array
             if -1.0 <= one <= 1.0:  # False for NaN
                 return self.config.max_burn_m_s * max(one, 0.0)
         value = np.asarray(action, dtype=np.float64) if not isinstance(action, (str, bytes)) else np.array(np.nan)
