@@ -19,7 +19,14 @@ from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate, reference_path
-from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution, universal_curves
+from orbit_env.decay.curves import (
+    CURVES_MAX_APOGEE_M,
+    CURVES_MAX_PERIGEE_M,
+    NU_REF,
+    UniversalCurves,
+    nu_per_revolution,
+    universal_curves,
+)
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
 from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
@@ -292,7 +299,6 @@ def lifetime(
             )
             scale = 1.0
         else:
-            UniversalCurves.check_domain_km(perigee_km, apogee_km)
             return _lifetime_under_activity(
                 hp_m,
                 ha_m,
@@ -406,12 +412,28 @@ def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
 def _lifetime_under_activity(
     hp_m: float, ha_m: float, satellite: Satellite, method: str, scale: float, model: SolarDecayModel
 ) -> LifetimeResult:
-    """The time-stepped NRLMSIS lifetime (see `lifetime`; the caller checked the heights)."""
+    """The time-stepped NRLMSIS lifetime (see `lifetime`; the caller checked the heights).
+
+    Above the curves' domain, by either method, the averaged equations in the mean air
+    of the lifetime (`orbit_env.decay.lifetime_mean`): the daily reference would take
+    hours over a GTO's decades.
+    """
     if method == "direct":
         raise ValueError("the direct method needs a fixed atmosphere; with changing solar activity use curves")
     c = satellite.drag_parameter_m2_kg
     per_nu = satellite.revolutions_per_nu
-    if method == "averaged":
+    if hp_m > CURVES_MAX_PERIGEE_M or ha_m > CURVES_MAX_APOGEE_M:
+        from orbit_env.decay.lifetime_mean import mean_air_lifetime
+
+        method = "averaged"
+        mean = mean_air_lifetime(hp_m, ha_m, c * scale, model)
+        days, reentered = mean.days, mean.reentered
+        t = mean.trajectory.weighted_s / (G0_M_S2 * c * scale) / SECONDS_PER_DAY
+        inside = t < days
+        t = np.append(t[inside], days)
+        hp_path = np.append(mean.trajectory.perigee_m[inside], mean.trajectory.perigee_m[-1])
+        ha_path = np.append(mean.trajectory.apogee_m[inside], mean.trajectory.apogee_m[-1])
+    elif method == "averaged":
         t, hp_path, ha_path = reference_path(hp_m, ha_m, c * scale, model)
         days = float(t[-1])
         reentered = days < model.max_years * 365.25
@@ -460,8 +482,10 @@ def check_rule(
     (perigee > 1100 km or apogee > 4000 km: a GTO, a Molniya orbit) a fixed atmosphere's
     lifetimes come from the averaged equations instead (one integration per candidate
     perigee, 49 in all; the same equations as ``lifetime(method="averaged")``, so the
-    printed lifetime and the verdict are one computation); a time-stepped scenario is
-    refused there.
+    printed lifetime and the verdict are one computation). A dated scenario's come from
+    the averaged equations in the mean air of the orbit's own lifetime
+    (`orbit_env.decay.lifetime_mean`, as `lifetime` gives it), the same air for every
+    candidate perigee.
 
     Example:
         >>> check = check_rule(800, 800, 25, satellite=Satellite(2.2, 100.0, 1.0))
@@ -476,7 +500,9 @@ def check_rule(
         UniversalCurves.check_domain_km(perigee_km, apogee_km)
     except InputError:
         if scenario.time_varying:
-            raise
+            return check_disposal_rule(
+                hp_m, ha_m, rule_years, _mean_air_lifetimes(scenario, c, inclination_deg, hp_m, ha_m)
+            )
         return check_disposal_rule(hp_m, ha_m, rule_years, _averaged_lifetimes(scenario, c, inclination_deg))
 
     def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
@@ -485,6 +511,20 @@ def check_rule(
         return scenario.lifetime_days(hp, ha, np.full(hp.shape, c), inclination_deg, max_days=cap_days)
 
     return check_disposal_rule(hp_m, ha_m, rule_years, lifetimes)
+
+
+def _mean_air_lifetimes(scenario: Scenario, c: float, inclination_deg: float, hp_m: Any, ha_m: Any) -> Any:
+    """The rule's lifetime function in the mean air of the orbit's lifetime (dated; any heights)."""
+    from orbit_env.decay.lifetime_mean import mean_air_lifetime, mean_air_lifetimes
+
+    scaled = c * scenario.density_scale
+    model = scenario.solar_model(inclination_deg)
+    start = mean_air_lifetime(float(np.ravel(hp_m)[0]), float(np.ravel(ha_m)[0]), scaled, model)
+
+    def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
+        return mean_air_lifetimes(hp, ha, scaled, start.model), np.ones(hp.size, dtype=bool)
+
+    return lifetimes
 
 
 def _averaged_lifetimes(scenario: Scenario, c: float, inclination_deg: float) -> Any:
