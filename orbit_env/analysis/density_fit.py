@@ -364,10 +364,12 @@ def _fit_reentry(
     step_h = max(sigma_h_km, 0.5) * 1e3
     d_hp = (log_scale(hp_m + step_h, max(ha_m, hp_m + step_h), dt_days) - best) / step_h
     d_ha = (log_scale(hp_m, ha_m + step_h, dt_days) - best) / step_h
-    variance = (sigma_t_days / dt_days) ** 2 + (d_hp**2 + d_ha**2) * (sigma_h_km * 1e3) ** 2
+    sigma_h_m = sigma_h_km * 1e3
     return DensityFit(
         scale=math.exp(best),
-        sigma_log=math.sqrt(variance),
+        # sqrt((sigma_t / dt)^2 + (d_hp^2 + d_ha^2) sigma_h^2), without squaring a large slope
+        # (a float's ** 2 raises OverflowError; the fuzz test found slopes near 1e160 per m).
+        sigma_log=math.hypot(sigma_t_days / dt_days, d_hp * sigma_h_m, d_ha * sigma_h_m),
         dof=None,
         description=f"re-entry {dt_days:.4g} days after a {hp_m / 1e3:g} x {ha_m / 1e3:g} km orbit",
     )
