@@ -94,9 +94,22 @@ class DecayModel:
         return EARTH_ROTATION_RAD_S * float(np.cos(np.radians(self.inclination_deg)))
 
     @cached_property
-    def _cos_sin(self) -> tuple[FloatArray, FloatArray]:
-        theta = np.linspace(0.0, 2.0 * np.pi, self.quadrature_points, endpoint=False)
-        return np.cos(theta), np.sin(theta)
+    def _cos_sin(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The anomalies of the rule from 0 to pi, and their weights.
+
+        Both integrands are even in theta (r and the speed depend on cos(theta); sin(theta)
+        enters squared), so the 2n-point rule over the circle is the rule over the half circle
+        with the inner points counted twice: the same sum in half the evaluations (an odd
+        n keeps its full circle).
+        """
+        n = self.quadrature_points
+        theta = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+        if n % 2:
+            return np.cos(theta), np.sin(theta), np.full(n, 1.0 / n)
+        half = theta[: n // 2 + 1]
+        weights = np.full(half.size, 2.0 / n)
+        weights[[0, -1]] = 1.0 / n
+        return np.cos(half), np.sin(half), weights
 
     def rates_per_nu(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """Orbit-averaged dp/dnu [m / (m^3 kg^-1 s^-2)] and de/dnu, both negative.
@@ -105,7 +118,7 @@ class DecayModel:
         """
         p = np.asarray(p_m, dtype=np.float64)[..., None]
         ecc = np.asarray(e, dtype=np.float64)[..., None]
-        cos, sin = self._cos_sin
+        cos, sin, weights = self._cos_sin
         k = 1.0 + ecc * cos
         r = p / k
         rho = self.atmosphere.density_kg_m3(r - EARTH_RADIUS_M)
@@ -114,8 +127,8 @@ class DecayModel:
         v_n_rel = v_scale * k - self.corotation_rad_s * r
         speed = np.sqrt(v_r * v_r + v_n_rel * v_n_rel)
         drag = rho * speed / MU_EARTH_M3_S2
-        dp = (r * r * r * drag * v_n_rel).mean(axis=-1)
-        de = (0.5 * r * r * drag * (sin * v_r + ((1.0 + 1.0 / k) * cos + ecc / k) * v_n_rel)).mean(axis=-1)
+        dp = (r * r * r * drag * v_n_rel) @ weights
+        de = (0.5 * r * r * drag * (sin * v_r + ((1.0 + 1.0 / k) * cos + ecc / k) * v_n_rel)) @ weights
         # Int_0^2pi = 2 pi * mean; the minus sign is drag; 1/g turns dN into dnu/(c).
         factor = -2.0 * np.pi / G0_M_S2
         return factor * dp, factor * de
