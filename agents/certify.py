@@ -123,7 +123,14 @@ class _Plans:
         made = np.zeros((k, self.horizon))
         running = np.ones(k, dtype=bool)
         for t in range(self.horizon):
-            action = policy.predict(obs, deterministic=True)[0] if policy is not None else self.actions(burns_m_s[:, t])
+            if policy is None:
+                action = self.actions(burns_m_s[:, t])
+            else:
+                # The policy acts on the episodes still scored; the restarted ones coast (a DP
+                # then reads one stage of its values a step, see orbit_env.agents.stage_values).
+                action = self.actions(np.zeros(k))
+                rows = np.flatnonzero(running)
+                action[rows] = policy.predict(obs[rows], deterministic=True)[0]
             obs, reward, terminated, truncated, info = env.step(action)
             returns += np.where(running, reward, 0.0)
             made[:, t] = np.where(running, info["burn_m_s"], 0.0)
