@@ -21,7 +21,10 @@ to the stage below or taking the stage above's increments away (V_{k-1} = V_k -
 Only the last two stages read are kept decoded (about 10 MB on the default grid,
 whatever the number of solutions held, as the oracle's nine), so the DP policy,
 which reads one stage a step in descending order (two with a look-ahead of two),
-decodes one increment a stage.
+decodes one increment a stage. Stages read far apart cost a decode from their keyframe
+each (up to 15 increments, a few milliseconds on the default grid): so `evaluate` and
+the certificate let the policy act only on the episodes still scored, not on those a
+vector env has restarted at other stages.
 """
 
 from __future__ import annotations
