@@ -180,6 +180,47 @@ def mean_density_kg_m3(
     )
 
 
+def _msis_density(
+    altitude_m: FloatArray,
+    lat: FloatArray,
+    local_time: FloatArray,
+    days: FloatArray,
+    f107_sfu: ArrayLike,
+    f107a_sfu: ArrayLike,
+    ap: ArrayLike,
+) -> FloatArray:
+    """NRLMSIS 2.1 mass density [kg/m^3] on a grid, in one call: shape (groups, days, samples, altitudes).
+
+    ``lat`` and ``local_time`` are (groups, samples) orbit samples; ``days`` are days of
+    the year from 0; the indices are per day (or scalars).
+    """
+    msis = require_pymsis()
+    lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
+    shape = (lat.shape[0], days.size, lat.shape[1], altitude_m.size)
+    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
+    dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[None, :, None, None], shape).ravel()
+    lats = np.broadcast_to(lat[:, None, :, None], shape).ravel()
+    lons = np.broadcast_to(lon[:, None, :, None], shape).ravel()
+    alts_km = geodetic_altitude_m(altitude_m[None, None, None, :], lat[:, None, :, None]) / 1e3
+    alts_km = np.broadcast_to(alts_km, shape).ravel()
+
+    def per_point(values: ArrayLike) -> FloatArray:
+        per_day = np.broadcast_to(np.asarray(values, dtype=np.float64), (days.size,))
+        return np.broadcast_to(per_day[None, :, None, None], shape).ravel()
+
+    out = msis.calculate(
+        dates,
+        lons,
+        lats,
+        alts_km,
+        f107s=per_point(f107_sfu),
+        f107as=per_point(f107a_sfu),
+        aps=np.repeat(per_point(ap)[:, None], 7, axis=1),
+        version=2.1,
+    )
+    return np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
+
+
 def mean_density_over_days_kg_m3(
     altitude_m: ArrayLike,
     f107_sfu: ArrayLike,
@@ -199,36 +240,11 @@ def mean_density_over_days_kg_m3(
     of densities, not the density of mean indices: NRLMSIS responds to Ap
     concavely, so averaging the indices would overstate the density after storms.
     """
-    msis = require_pymsis()
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
     days = np.atleast_1d(np.asarray(day_of_year, dtype=np.float64)) - 1.0
-    lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
-    n_days, n_samples, n_alt = days.size, lat.size, alt.size
-    shape = (n_days, n_samples, n_alt)
-    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
-    dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[:, None, None], shape).ravel()
-    lats = np.broadcast_to(lat[None, :, None], shape).ravel()
-    lons = np.broadcast_to(lon[None, :, None], shape).ravel()
-    alts_km = geodetic_altitude_m(alt[None, None, :], lat[None, :, None]) / 1e3
-    alts_km = np.broadcast_to(alts_km, shape).ravel()
-
-    def per_point(values: ArrayLike) -> FloatArray:
-        per_day = np.broadcast_to(np.asarray(values, dtype=np.float64), (n_days,))
-        return np.broadcast_to(per_day[:, None, None], shape).ravel()
-
-    out = msis.calculate(
-        dates,
-        lons,
-        lats,
-        alts_km,
-        f107s=per_point(f107_sfu),
-        f107as=per_point(f107a_sfu),
-        aps=np.repeat(per_point(ap)[:, None], 7, axis=1),
-        version=2.1,
-    )
-    rho = np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
-    return rho.mean(axis=(0, 1))
+    rho = _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap)
+    return rho[0].mean(axis=(0, 1))
 
 
 def mean_density_over_inclinations_kg_m3(
@@ -250,34 +266,15 @@ def mean_density_over_inclinations_kg_m3(
     cost is per point, but a catalogue spread over inclinations should not pay
     ``pymsis``'s set-up once per inclination.
     """
-    msis = require_pymsis()
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     inclinations = np.atleast_1d(np.asarray(inclinations_deg, dtype=np.float64))
     samples = [
         orbit_samples(float(i), ascending_node_local_time_h, latitude_nodes, local_time_nodes) for i in inclinations
     ]
     lat = np.stack([s[0] for s in samples])  # (inclinations, samples)
-    lon = np.mod((np.stack([s[1] for s in samples]) - _UT_HOURS) * 15.0, 360.0)
+    local_time = np.stack([s[1] for s in samples])
     days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
-    shape = (inclinations.size, days.size, lat.shape[1], alt.size)
-    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
-    dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[None, :, None, None], shape).ravel()
-    lats = np.broadcast_to(lat[:, None, :, None], shape).ravel()
-    lons = np.broadcast_to(lon[:, None, :, None], shape).ravel()
-    alts_km = np.broadcast_to(geodetic_altitude_m(alt[None, None, None, :], lat[:, None, :, None]) / 1e3, shape).ravel()
-    ones = np.ones(alts_km.size)
-    out = msis.calculate(
-        dates,
-        lons,
-        lats,
-        alts_km,
-        f107s=f107_sfu * ones,
-        f107as=f107a_sfu * ones,
-        aps=np.full((alts_km.size, 7), float(ap)),
-        version=2.1,
-    )
-    rho = np.asarray(out[..., 0], dtype=np.float64).reshape(shape)
-    return rho.mean(axis=(1, 2))
+    return _msis_density(alt, lat, local_time, days, f107_sfu, f107a_sfu, ap).mean(axis=(1, 2))
 
 
 @lru_cache(maxsize=256)
