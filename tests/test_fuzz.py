@@ -159,13 +159,21 @@ def lifetime_argv(draw: st.DrawFn) -> list[str]:
     return argv
 
 
-def check_lifetime(argv: list[str]) -> None:
+def checked_run(argv: list[str]) -> str | None:
+    """Run the command: its output if it succeeded (clean stderr, finite numbers), None if it failed as it should."""
     status, out, err, caught = cli(argv)
     if status != 0:
         check_failure(status, out, err, argv)
-        return
+        return None
     check_clean_stderr(err, caught, argv)
     assert not NOT_FINITE.search(out), (argv, out)
+    return out
+
+
+def check_lifetime(argv: list[str]) -> None:
+    out = checked_run(argv)
+    if out is None:
+        return
     hp_km, ha_km = float(typed(argv, "--perigee")), float(typed(argv, "--apogee"))
     if "--json" not in argv:
         days = float(re.search(r"^lifetime\s+(\S+) days", out, re.MULTILINE).group(1))
@@ -259,12 +267,9 @@ def check_fit(tmp: Path, text: str, options: list[str]) -> None:
     path = tmp / "obs.csv"
     path.write_text(text)
     argv = ["fit-density", str(path), *options]
-    status, out, err, caught = cli(argv)
-    if status != 0:
-        check_failure(status, out, err, argv)
+    out = checked_run(argv)
+    if out is None:
         return
-    check_clean_stderr(err, caught, argv)
-    assert not NOT_FINITE.search(out), (argv, out)
     if "--json" not in argv:
         assert re.search(r"^density scale\s+\S+", out, re.MULTILINE), out
         return
