@@ -55,6 +55,7 @@ from orbit_env.envs.config import (
     OrbitRaisingConfig,
     validate_satellite,
 )
+from orbit_env.envs.kernel import burn_rows
 from orbit_env.physics.orbit import (
     apogee_after_perigee_burn_m,
     elements_from_heights,
@@ -741,8 +742,11 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
             update_satellite(task, state)
             place(task, state, state.perigee_m, apogee_m)
         return dv
-    made = np.zeros(state.size)
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s) > 0.0)  # asked to burn, and able to
+    compiled = burn_rows(state.data, asked, requested_dv_m_s, task.curves, task.density) if asked.size else None
+    if compiled is not None:
+        return compiled  # the same burns, one compiled loop (orbit_env.envs.kernel)
+    made = np.zeros(state.size)
     if asked.size:
         requested = requested_dv_m_s[asked] if np.ndim(requested_dv_m_s) else requested_dv_m_s
         # The few that burn, gathered once, moved as a batch of their own, and written back once.

@@ -1,0 +1,138 @@
+"""The compiled burns (`orbit_env.envs.kernel`) against the numpy task model they compile.
+
+`orbit_env.envs.task.step` with the compiled burns and with numpy's steps copies of
+the same `BatchState` through random burns (of every size,
+the tank emptied, the 4000 km apogee cap reached), re-entries and restarts, and must
+agree at every step. Tolerance, and why: the loop calls the C library's ``exp``,
+``log``, ``expm1`` and ``sin`` on one number at a time, numpy its SIMD
+versions on arrays; the two may differ in the last bit (the same difference as the
+single environment's floats against the vector environment's, see
+``tests/test_envs.py``). A step's days are a difference of two W values up to 10^4
+times larger, which amplifies a last-bit difference to about 1e-12 relative; the
+test allows 1e-10 relative on the float64 state and rewards (and 1e-9 day absolute on
+the rewards, as ``tests/test_envs.py``), and 1e-6 m on the heights' drops
+over a step (differences of two heights of ~1e6 m, each good to 1e-12 relative). The float32 observations may
+round a value that sits on a float32 boundary either way: 1e-6 (16 ulps of float32).
+The cells of table B (which cell each orbit is in) and the episode ends must be equal.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import orbit_env  # noqa: F401  (registers the environments)
+from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig
+from orbit_env.envs import kernel as kernel_module
+from orbit_env.envs import task as task_model
+from orbit_env.envs.task import STATE_FIELDS, Task
+
+pytestmark = pytest.mark.skipif(kernel_module.compiled() is None, reason="needs numba (and ORBIT_ENV_JIT not 0)")
+
+TASKS = {
+    "v0": Task.of(),
+    "continuous": Task.of(continuous=True),
+    "uncertain": Task.of(density=DensityConfig(scale_range=(0.5, 2.0), cycle_amplitude=0.3)),
+    # Cheap propellant and big burns: the apogee cap and empty tanks in most episodes.
+    "cap": Task.of(OrbitRaisingConfig(propellant_cost_per_m_s=0.0, burn_sizes_m_s=(0.0, 300.0, 900.0))),
+}
+
+
+def _requests(task: Task, rng: np.random.Generator, n: int) -> np.ndarray:
+    if task.continuous:
+        return task.requested_dvs(rng.uniform(-1.0, 1.0, (n, 1)).astype(np.float32), n)
+    return task.requested_dvs(rng.integers(0, len(task.config.burn_sizes_m_s), n), n)
+
+
+def test_state_rows_are_the_kernels() -> None:
+    assert STATE_FIELDS.index("label") == kernel_module._LABEL
+    for name, row in (
+        ("apogee_m", "_APOGEE"),
+        ("mass_kg", "_MASS"),
+        ("nu_per_rev", "_NU_PER_REV"),
+        ("steps", "_STEPS"),
+    ):
+        assert STATE_FIELDS.index(name) == getattr(kernel_module, row), name
+    assert kernel_module._SEGMENT == len(STATE_FIELDS)
+
+
+def _numpy_step(task: Task, state: task_model.BatchState, requested: np.ndarray) -> task_model.StepResult:
+    """`task.step` with numpy's burns (no batch small enough for the compiled loop)."""
+    limit = kernel_module.MAX_COMPILED_ROWS
+    kernel_module.MAX_COMPILED_ROWS = -1
+    try:
+        return task_model.step(task, state, requested)
+    finally:
+        kernel_module.MAX_COMPILED_ROWS = limit
+
+
+@pytest.mark.parametrize("name", list(TASKS))
+def test_compiled_burns_equal_the_task_model(name: str) -> None:
+    task = TASKS[name]
+    rng = np.random.default_rng(7)
+    n, steps = 512, 400
+    numpy_state = task_model.start(task, rng, n)
+    compiled_state = numpy_state.copy()
+    ends = 0
+    burned = 0
+    for _ in range(steps):
+        requested = _requests(task, rng, n)
+        expected = _numpy_step(task, numpy_state, requested)
+        expected_obs = task_model.observe(task, numpy_state)
+        got = task_model.step(task, compiled_state, requested)
+        obs = task_model.observe(task, compiled_state)
+        for field, want, have in zip(("reward", "terminated", "truncated", "burn"), expected, got, strict=True):
+            if want.dtype == np.bool_:
+                np.testing.assert_array_equal(have, want, err_msg=field)
+            else:
+                # A step's days are a difference of two W values worth up to 1e4 days: 1e-9 day absolute.
+                np.testing.assert_allclose(have, want, rtol=1e-10, atol=1e-9, err_msg=field)
+        for row, field in enumerate(STATE_FIELDS):
+            # A drop is a difference of two heights of ~1e6 m: their 1e-12 relative is 1e-6 m.
+            atol = 1e-6 if field.endswith("_drop_m") else 1e-12
+            np.testing.assert_allclose(
+                compiled_state.data[row], numpy_state.data[row], rtol=1e-10, atol=atol, err_msg=field
+            )
+        np.testing.assert_array_equal(compiled_state.segments[0], numpy_state.segments[0])  # the cells of table B
+        np.testing.assert_allclose(obs, expected_obs, rtol=1e-6, atol=1e-7)
+        burned += int(np.count_nonzero(expected.burn_m_s))
+        done = np.flatnonzero(expected.terminated | expected.truncated)
+        if done.size:  # restart them in both, with the same fresh missions
+            ends += done.size
+            fresh = task_model.start(task, rng, done.size)
+            numpy_state.put(done, fresh)
+            compiled_state.put(done, fresh)
+    # The run exercised what it is meant to: many burns and many episode ends.
+    assert burned > 1000 and ends > 100, (burned, ends)
+
+
+def test_the_vector_env_steps_the_same_without_numba(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The fallback (no numba, or ORBIT_ENV_JIT=0) is the task model itself: the same episodes."""
+    actions = np.random.default_rng(3).integers(0, 4, (300, 64))
+
+    def rollout() -> list[np.ndarray]:
+        env = gym.make_vec(ENV_IDS[0], num_envs=64)
+        obs, _ = env.reset(seed=5)
+        out = [obs]
+        for a in actions:
+            obs, reward, *_ = env.step(a)
+            out += [obs, reward]
+        return out
+
+    compiled = rollout()
+    monkeypatch.setattr(kernel_module, "compiled", lambda: None)
+    fallback = rollout()
+    for have, want in zip(compiled, fallback, strict=True):
+        np.testing.assert_allclose(have, want, rtol=1e-6, atol=1e-7)
+
+
+def test_jit_can_be_switched_off(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv(kernel_module.JIT_VARIABLE, "0")
+    kernel_module.compiled.cache_clear()
+    try:
+        assert kernel_module.compiled() is None
+    finally:
+        monkeypatch.delenv(kernel_module.JIT_VARIABLE)
+        kernel_module.compiled.cache_clear()
+    assert kernel_module.compiled() is not None
