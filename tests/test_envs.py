@@ -39,6 +39,7 @@ from orbit_env.decay import curves as curves_module
 from orbit_env.decay.averaged import integrate_averaged
 from orbit_env.decay.curves import CurvePoint, nu_per_revolution, universal_curves
 from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig, OrbitRaisingEnv, register_envs
+from orbit_env.envs import kernel as kernel_module
 from orbit_env.envs import orbit_raising as orbit_raising_module
 from orbit_env.envs.config import CONFIG_FIELDS, DEFAULT_HORIZON_STEPS, DENSITY_FIELDS, UNCERTAIN_DENSITY
 from orbit_env.envs.task import OBS_HIGH, delta_v_left_m_s
@@ -981,7 +982,25 @@ def test_cell_interpolation_is_the_plain_formula():
 
 
 def test_vector_env_uses_the_curves_not_a_copy(monkeypatch):
-    """Breaking the curves must break the env: it has no dynamics of its own."""
+    """Breaking the curves must break the env: it has no dynamics of its own, compiled or not."""
+
+    def first_step():
+        vec = OrbitRaisingVectorEnv(32)
+        vec.reset(seed=0)
+        return vec.step(np.full(32, 2, dtype=np.int64))[0]  # burns too
+
+    before = first_step()
+    cells = universal_curves()._table_b.cells  # what the compiled loops read (orbit_env.envs.kernel)
+    saved = cells.copy()
+    try:
+        cells[..., 0] *= 1.001
+        broken = first_step()
+    finally:
+        cells[...] = saved
+    assert not np.allclose(broken, before, rtol=1e-4)
+    np.testing.assert_array_equal(first_step(), before)
+
+    # Without the compiled loops, both envs coast through the curves' own method.
     calls = []
     original = type(universal_curves()).advance_heights
 
@@ -990,6 +1009,7 @@ def test_vector_env_uses_the_curves_not_a_copy(monkeypatch):
         return original(self, point, dnu, segments)
 
     monkeypatch.setattr(type(universal_curves()), "advance_heights", spy)
+    monkeypatch.setattr(kernel_module, "compiled", lambda: None)
     vec = OrbitRaisingVectorEnv(32)
     vec.reset(seed=0)
     vec.step(np.zeros(32, dtype=np.int64))

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import os
 from functools import lru_cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -190,6 +190,135 @@ def _burn_rows(
         made[k] = _burn(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
 
 
+# Parameters of a coast and its observation, in a float array (`coast_parameters`).
+_REVOLUTIONS, _COST, _HORIZON, _C_VARIES, _C_AMPLITUDE, _C_PERIOD_DAYS = range(6)
+_HEIGHT_SCALE, _DV_SCALE, _LIFETIME_SCALE, _APOGEE_DROP_SCALE, _PERIGEE_DROP_SCALE = range(6, 11)
+
+# fdlibm's reduction by pi/2 (e_rem_pio2.c: 33 bits of pi/2, and the rest) and its sine and cosine
+# polynomials on [-pi/4, pi/4] (k_sin.c, k_cos.c).
+_INV_PIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_1T = 6.07710050650619224932e-11
+_S1, _S2, _S3 = -1.66666666666666324348e-01, 8.33333333332248946124e-03, -1.98412698298579493134e-04
+_S4, _S5, _S6 = 2.75573137070700676789e-06, -2.50507602534068634195e-08, 1.58969099521155010221e-10
+_C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015872894767294178e-05
+_C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
+#: Above this |x| the one-step reduction by pi/2 loses digits: `_sine` calls the C library there.
+_SINE_REDUCTION_LIMIT = 1e5
+
+
+def _sine(x: float) -> float:
+    """The sine without a library call or a branch, so that a loop of them compiles to SIMD (the C library's does not).
+
+    fdlibm's method: x = n pi/2 + r, |r| <= pi/4, then its sine or cosine polynomial
+    by the quadrant n mod 4. Within 1.2e-16 of the C library's ``sin`` for
+    |x| <= `_SINE_REDUCTION_LIMIT` (tests/test_kernel.py); callers take the C library's beyond.
+    """
+    n = math.floor(x * _INV_PIO2 + 0.5)
+    r = (x - n * _PIO2_1) - n * _PIO2_1T
+    z = r * r
+    sine = r + z * r * (_S1 + z * (_S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))))
+    cosine = 1.0 - (0.5 * z - z * z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6))))))
+    quadrant = int(n) & 3
+    value = cosine if quadrant & 1 else sine
+    return -value if quadrant & 2 else value
+
+
+def _modulation_exponents(time_days: FloatArray, phase_rad: FloatArray, p: FloatArray, out: FloatArray) -> None:
+    """A sin(2 pi t / T + phi) of every satellite: the exponent of `task.density_scale_at`."""
+    # Locals, not reads of p in the loop: ``out`` could alias p, which would keep the loop scalar.
+    amplitude, period_days = p[_C_AMPLITUDE], p[_C_PERIOD_DAYS]
+    beyond = 0  # an integer count: a float reduction would not vectorize without fast-math
+    for k in range(time_days.size):
+        angle = TWO_PI * time_days[k] / period_days + phase_rad[k]
+        out[k] = amplitude * _sine(angle)
+        beyond += abs(angle) > _SINE_REDUCTION_LIMIT
+    if beyond:  # beyond 16,000 periods: the C library's reduction
+        for k in range(time_days.size):
+            out[k] = amplitude * math.sin(TWO_PI * time_days[k] / period_days + phase_rad[k])
+
+
+def _coast_start(data: FloatArray, p: FloatArray, modulation: FloatArray, nu_after: FloatArray, x: FloatArray) -> None:
+    """`task.update_density` (if the density varies; ``modulation`` = exp of the exponents), then nu after the coast.
+
+    ``x`` gets nu / NU_REF, whose log1p is the new tau (`UniversalCurves._after`).
+    """
+    for k in range(data.shape[1]):
+        if p[_C_VARIES] != 0.0:
+            scale = data[_BASE, k] * modulation[k]
+            data[_SCALE, k] = scale
+            data[_NU_PER_REV, k] = G0_M_S2 * (data[_AREA, k] / data[_MASS, k] * scale)
+        nu = max(data[_NU, k] - p[_REVOLUTIONS] * data[_NU_PER_REV, k], 0.0)
+        nu_after[k] = nu
+        x[k] = nu * (1.0 / NU_REF)
+
+
+def _coast_cells(
+    data: FloatArray, b_cells: FloatArray, b_grid: FloatArray, tau: FloatArray, exponent: FloatArray
+) -> None:
+    """Each orbit's place in its cell of table B at the new tau (a new cell if it left its own): ty into ``tau``.
+
+    ``exponent`` gets ln e - mu + mu along the cell, whose exp is e (`curves._heights`).
+    """
+    for k in range(data.shape[1]):
+        label = data[_LABEL, k]
+        ty = tau[k] * b_grid[_Y_SCALE]
+        if b_grid[_Y_OFFSET] != 0.0:
+            ty -= b_grid[_Y_OFFSET]
+        ty -= data[_SEGMENT, k]
+        if ty < 0.0 or ty > 1.0:  # left its cell (or a stale cell, j = -inf)
+            ty = _new_segment(data, k, b_cells, b_grid, label, tau[k])
+        data[_TAU, k] = tau[k]
+        tau[k] = ty
+        exponent[k] = data[_SEGMENT + 5, k] * ty + data[_SEGMENT + 2, k] + label
+
+
+def _coast_finish(
+    data: FloatArray,
+    p: FloatArray,
+    nu_after: FloatArray,
+    ty_all: FloatArray,
+    eccentricity: FloatArray,
+    made: FloatArray,
+    reward: FloatArray,
+    terminated: NDArray[np.bool_],
+    truncated: NDArray[np.bool_],
+    obs: NDArray[np.float32],
+) -> None:
+    """The rest of `task.coast` (heights, days, drops, clock), `task.step`'s reward and ends, `task.observe`."""
+    for k in range(data.shape[1]):
+        ty = ty_all[k]
+        nu = nu_after[k]
+        hp = max(data[_SEGMENT + 4, k] * ty + data[_SEGMENT + 1, k], REENTRY_ALTITUDE_M)
+        rp = hp + EARTH_RADIUS_M
+        apogee = (rp + rp) / (1.0 - eccentricity[k]) - rp - EARTH_RADIUS_M
+        period = data[_SEGMENT + 6, k] * ty + data[_SEGMENT + 3, k]
+        days = (data[_PERIOD, k] * data[_NU, k] - period * nu) / (data[_NU_PER_REV, k] * SECONDS_PER_DAY)
+        perigee_drop = data[_PERIGEE, k] - hp
+        apogee_drop = data[_APOGEE, k] - apogee
+        data[_PERIGEE_DROP, k] = perigee_drop
+        data[_APOGEE_DROP, k] = apogee_drop
+        data[_PERIGEE, k] = hp
+        data[_APOGEE, k] = apogee
+        data[_PERIOD, k] = period
+        data[_NU, k] = nu
+        data[_TIME, k] += days
+        steps = data[_STEPS, k] + 1.0
+        data[_STEPS, k] = steps
+        reward[k] = days - p[_COST] * made[k] if p[_COST] != 0.0 else days
+        terminated[k] = data[_TAU, k] <= 0.0
+        truncated[k] = steps >= p[_HORIZON]
+        # `task.observation` (a batch's clock is not clamped, as in `task.observe`).
+        life = period * nu / data[_NOMINAL_W, k]
+        obs[k, 0] = hp * p[_HEIGHT_SCALE]
+        obs[k, 1] = apogee * p[_HEIGHT_SCALE]
+        obs[k, 2] = data[_DV_LEFT, k] * p[_DV_SCALE]
+        obs[k, 3] = steps * (1.0 / p[_HORIZON])
+        obs[k, 4] = life / (life + p[_LIFETIME_SCALE])
+        obs[k, 5] = apogee_drop / (apogee_drop + p[_APOGEE_DROP_SCALE])
+        obs[k, 6] = perigee_drop / (perigee_drop + p[_PERIGEE_DROP_SCALE])
+
+
 def _grid_parameters(grid: Any) -> FloatArray:
     """A `_Grid`'s scales and bounds, in the order of the ``_NY ... _Y_TOP`` indices."""
     return np.array(
@@ -197,9 +326,19 @@ def _grid_parameters(grid: Any) -> FloatArray:
     )
 
 
+class _Kernels(NamedTuple):
+    """The compiled loops."""
+
+    burn_rows: Any
+    modulation_exponents: Any
+    coast_start: Any
+    coast_cells: Any
+    coast_finish: Any
+
+
 @lru_cache(maxsize=1)
-def compiled() -> Any:
-    """The compiled `_step_rows` (numba, compiled on first use and cached on disk), or None without numba.
+def compiled() -> _Kernels | None:
+    """The compiled loops (numba, compiled on first use and cached on disk), or None without numba.
 
     None also when the environment variable ``ORBIT_ENV_JIT`` is ``0``.
     """
@@ -209,11 +348,12 @@ def compiled() -> Any:
         import numba
     except ImportError:
         return None
-    helpers = (_cell, _locate, _new_segment, _heights_on_segment, _perigee_speed_m_s, _apogee_after_m)
+    helpers = (_cell, _locate, _new_segment, _heights_on_segment, _perigee_speed_m_s, _apogee_after_m, _sine)
     for helper in (*helpers, _update_density, _burn):
-        # Callable from the compiled loop (unchanged from Python), inlined there: no call per satellite.
+        # Callable from the compiled loops (unchanged from Python), inlined there: no call per satellite.
         numba.extending.register_jitable(inline="always")(helper)
-    return numba.njit(cache=True, nogil=True)(_burn_rows)
+    loops = (_burn_rows, _modulation_exponents, _coast_start, _coast_cells, _coast_finish)
+    return _Kernels(*(numba.njit(cache=True, nogil=True)(loop) for loop in loops))
 
 
 @lru_cache(maxsize=8)
@@ -258,13 +398,49 @@ def burn_rows(
     """
     if rows.size > MAX_COMPILED_ROWS:
         return None
-    kernel = compiled()
-    if kernel is None:
+    kernels = compiled()
+    if kernels is None:
         return None
     n = state_data.shape[1]
     requested = np.asarray(requested_dv_m_s, dtype=np.float64)
     if requested.shape != (n,):
         requested = np.full(n, float(requested))
     made = np.zeros(n)
-    kernel(state_data, rows, requested, _parameters(density), *_tables(curves), made)
+    kernels.burn_rows(state_data, rows, requested, _parameters(density), *_tables(curves), made)
     return made
+
+
+def coast_and_observe(
+    state_data: FloatArray, made_m_s: FloatArray, parameters: FloatArray, curves: UniversalCurves
+) -> tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_], NDArray[np.float32]]:
+    """The rest of a batch's step after its burns, compiled: density, coast, reward, ends, observation.
+
+    ``exp``, ``log1p`` and ``exp`` run as numpy's SIMD calls between the loops: the C
+    library's, one number at a time in a compiled loop, cost twice as much.
+
+    Args:
+        state_data: A `~orbit_env.envs.task.BatchState`'s array, updated in place.
+        made_m_s: The burns made in this step [m/s], shape (n,).
+        parameters: `coast_parameters` of the task.
+        curves: The curves the task steps on.
+
+    Returns:
+        (reward, terminated, truncated, observation (n, 7) float32).
+    """
+    kernels = compiled()
+    assert kernels is not None, "coast_and_observe needs the compiled loops"
+    n = state_data.shape[1]
+    _, _, b_cells, b_grid = _tables(curves)
+    first, second = np.empty(n), np.empty(n)
+    if parameters[_C_VARIES] != 0.0:
+        kernels.modulation_exponents(state_data[_TIME], state_data[_PHASE], parameters, first)
+        np.exp(first, out=first)
+    nu_after = np.empty(n)
+    kernels.coast_start(state_data, parameters, first, nu_after, second)
+    np.log1p(second, out=second)  # tau
+    kernels.coast_cells(state_data, b_cells, b_grid, second, first)
+    np.exp(first, out=first)  # e
+    reward, obs = np.empty(n), np.empty((n, 7), dtype=np.float32)
+    terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    kernels.coast_finish(state_data, parameters, nu_after, second, first, made_m_s, reward, terminated, truncated, obs)
+    return reward, terminated, truncated, obs

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -49,13 +49,13 @@ from orbit_env.decay.curves import (
     nu_per_revolution,
     universal_curves,
 )
+from orbit_env.envs import kernel
 from orbit_env.envs.config import (
     MAX_DV_CAPACITY_M_S,
     DensityConfig,
     OrbitRaisingConfig,
     validate_satellite,
 )
-from orbit_env.envs.kernel import burn_rows
 from orbit_env.physics.orbit import (
     apogee_after_perigee_burn_m,
     elements_from_heights,
@@ -743,7 +743,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
             place(task, state, state.perigee_m, apogee_m)
         return dv
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s) > 0.0)  # asked to burn, and able to
-    compiled = burn_rows(state.data, asked, requested_dv_m_s, task.curves, task.density) if asked.size else None
+    compiled = kernel.burn_rows(state.data, asked, requested_dv_m_s, task.curves, task.density) if asked.size else None
     if compiled is not None:
         return compiled  # the same burns, one compiled loop (orbit_env.envs.kernel)
     made = np.zeros(state.size)
@@ -831,6 +831,33 @@ def step(task: Task, state: AnyState, requested_dv_m_s: Any) -> StepResult:
     cost = task.config.propellant_cost_per_m_s
     reward = days - cost * dv if cost else days
     return StepResult(reward, state.tau <= 0.0, state.steps >= task.config.horizon_steps, dv)
+
+
+@lru_cache(maxsize=16)
+def coast_parameters(task: Task) -> FloatArray:
+    """The numbers of a task that `orbit_env.envs.kernel.coast_and_observe` reads, in its order."""
+    config, density = task.config, task.density
+    values = [config.revolutions_per_step, config.propellant_cost_per_m_s, config.horizon_steps, density.varies]
+    values += [density.cycle_amplitude, density.cycle_period_days, 1.0 / HEIGHT_SCALE_M, 1.0 / DV_SCALE_M_S]
+    values += [LIFETIME_SCALE_DAYS, APOGEE_DROP_SCALE_M, PERIGEE_DROP_SCALE_M]
+    return np.array(values, dtype=np.float64)
+
+
+def step_and_observe(
+    task: Task, state: BatchState, requested_dv_m_s: FloatArray
+) -> tuple[StepResult, NDArray[np.float32]]:
+    """`step`, then `observe`, of a batch: what a vector environment's step does.
+
+    The coast, reward and observation after the burns run as compiled loops where
+    numba is there (`orbit_env.envs.kernel.coast_and_observe`, the same formulas in
+    the same order, tested equal to round-off), else as `step` and `observe`.
+    """
+    if kernel.compiled() is None:
+        result = step(task, state, requested_dv_m_s)
+        return result, observe(task, state)
+    dv = burn(task, state, requested_dv_m_s)
+    reward, terminated, truncated, obs = kernel.coast_and_observe(state.data, dv, coast_parameters(task), task.curves)
+    return StepResult(reward, terminated, truncated, dv), obs
 
 
 # ---------------------------------------------------------------------------------

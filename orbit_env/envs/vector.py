@@ -191,8 +191,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
                     "restart them with reset(options={'reset_mask': mask}) before stepping them"
                 )
             requested[restart] = 0.0  # NEXT_STEP: the action of a finished satellite is ignored
-        reward, terminated, truncated, dv = task_model.step(task, self._state, requested)
-        obs = task_model.observe(task, self._state)
+        (reward, terminated, truncated, dv), obs = task_model.step_and_observe(task, self._state, requested)
         # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._everyone_mask}
         if restart.size:
