@@ -26,22 +26,30 @@ satellites through time in chunks (``chunk_days``, default 20 days); in each chu
    its perigee, where a storm heats the thermosphere more and the season changes
    the profile's shape. Near re-entry (step 5), where short lives are decided,
    orbits wider than a e / H = `AVERAGED_MIN_X` take s from the averaged equations
-   themselves: dp/dnu under the chunk's profile over dp/dnu under the bin's. With
-   the ratio at the perigee alone, lives of 10-40 days on orbits 120 km wide came
-   out up to 3.2% off the daily reference, with the orbit's ratio within 0.65%
-   (docs/validation-modern.md). The decay rate is linear in density, so what is
-   left is the difference in the profile's shape that one multiplier cannot carry
-   (second order in the bin step);
+   themselves, weighted by what the life left depends on: the orbit moves along the
+   bin's curve, where W (below) is the life left, so s is dW/dt under the chunk's
+   profile over dW/dt under the bin's, (W_p p' + W_e e') / (W_p p'_bin + W_e e'_bin),
+   with the rates p', e' of the averaged equations and the gradient of W on the
+   bin's curves (`SolarDecayModel.weight_of`). A ratio of dp/dnu alone moves the
+   perigee at the chunk's rate but not the eccentricity, which the season's change
+   of the profile's shape moves differently: lives of 20-40 days on orbits 120 km
+   wide came out up to -0.58% off the daily reference, and within 0.22% with the
+   gradient's weights (docs/validation-modern.md). The decay rate is linear in
+   density, so what is left is the drift off the bin's curve, second order;
 4. the satellite moves along its curve by the chunk's time: W = Int P dnu falls by
    dt g c s (``orbit_env.decay.averaged``), solved for nu by Newton's method with
    dW/dnu = P (the Keplerian period). If W left is smaller, it re-enters within
    the chunk;
 5. near re-entry (less than `FINE_CHUNKS` chunks of decay left at the chunk's
-   rate) a chunk goes one day at a time (`FINISH_STEP_DAYS`), each day with its
-   own density multiplier at that day's orbit, so the last weeks, where the perigee
-   falls fastest, are resolved (and recorded) day by day. With one multiplier per
-   chunk, taken at the chunk's start height, lives of a few weeks came out 0.5-3.4%
-   off the daily reference (measured in docs/validation-modern.md).
+   rate) a chunk goes one day at a time (`FINISH_STEP_DAYS`), each day with the
+   density multiplier at that day's orbit of the profile at the day's middle (the
+   daily profiles' logarithms interpolated in time, as the reference does), and the
+   last `LAST_DAYS` days, where the perigee falls tens of km a day, in quarter days
+   (`LAST_STEPS`), so the last weeks are resolved (and recorded) day by day. The
+   days' ratios come from one NRLMSIS call per chunk. With each day's indices held
+   over the day and one step a day, lives of 10-20 days came out up to 0.81% off
+   the daily reference (9 of 36 above 0.5%), and within 0.36% so
+   (docs/validation-modern.md).
 
 Satellites are re-located on the curves only when the bin changes. Everything is
 vectorized over satellites. The measured effect of the chunk length and the bin
@@ -70,9 +78,11 @@ from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
     SEASON_NODES,
     MsisAtmosphere,
+    _msis_density,
     interpolate_log_density,
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
+    orbit_samples,
 )
 from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
@@ -82,13 +92,21 @@ FloatArray = NDArray[np.float64]
 DEFAULT_CHUNK_DAYS = 20.0
 #: Default bin step in ln(81-day mean F10.7).
 DEFAULT_BIN_STEP = 0.1
-#: Default cap on the time propagated [years]; a satellite still up then is reported as such.
 #: Sub-step [days] of the chunks near re-entry.
 FINISH_STEP_DAYS = 1.0
+#: A satellite with less than this many days left at the day's rate takes `LAST_STEPS` steps a day.
+LAST_DAYS = 4.0
+#: Steps a day in the last `LAST_DAYS` days.
+LAST_STEPS = 4
+#: Steps of the forward differences of W (the life left on a bin's curves) in p [m] and in e: halved or
+#: multiplied by 4, the 120 km wide short lives of docs/validation-modern.md move by at most 0.03%.
+GRADIENT_STEP_P_M = 500.0
+GRADIENT_STEP_E = 5e-5
 #: A chunk goes in daily sub-steps when less than this many chunks of decay (at the chunk's rate) are left.
 FINE_CHUNKS = 3.0
+#: Default cap on the time propagated [years]; a satellite still up then is reported as such.
 DEFAULT_MAX_YEARS = 200.0
-#: Near re-entry, orbits with a e / H above this take the multiplier from the averaged equations.
+#: Near re-entry, orbits with a e / H above this take the multiplier from the averaged equations (W-weighted).
 AVERAGED_MIN_X = 0.5
 #: Anomalies of that average (a ratio of two averages on the same nodes: 8 agree with 64 to 2e-5 in lifetime,
 #: measured on three 120 km wide orbits in their last month).
@@ -130,6 +148,22 @@ def _log_ratio(
         RATIO_GRID_M, f107, f107a, ap, doy, inclination_deg, ascending_node_local_time_h, **RATIO_NODES
     )
     return np.log(rho_exact) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h)
+
+
+@lru_cache(maxsize=1024)
+def _log_ratios_by_day(
+    daily: DailyIndices,
+    per_day: int,
+    binned: tuple[float, float],
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None,
+) -> FloatArray:
+    """`_log_ratio` of each day of ``daily`` (``per_day`` rows each), in one NRLMSIS call: shape (days, heights)."""
+    f107, f107a, ap, doy = (np.array(column) for column in zip(*daily, strict=True))
+    lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, **RATIO_NODES)
+    rho = _msis_density(RATIO_GRID_M, lat[None, :], local_time[None, :], doy - 1.0, f107, f107a, ap)[0]
+    rho_days = rho.reshape(-1, per_day, *rho.shape[1:]).mean(axis=(1, 2))
+    return np.log(rho_days) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h)[None, :]
 
 
 @lru_cache(maxsize=256)
@@ -224,20 +258,48 @@ class SolarDecayModel:
         # One sample at the start of each day: a daily table's rows are then taken as they are
         # (midpoints would interpolate between two days and smooth the storms away).
         days = self.start_days + t_days + np.arange(samples) * (self.chunk_days / samples)
+        daily = self.daily_indices(days)
+        _, f107a, ap = self.activity.indices(days)
+        return daily, bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step)
+
+    def daily_indices(self, days: FloatArray) -> DailyIndices:
+        """(F10.7, 81-day mean, Ap, day of the year) at each of ``days`` (Unix days), rounded for the caches.
+
+        Without ``follow_season`` each day is `SEASON_NODES` entries, one per node of the year.
+        """
         f107, f107a, ap = self.activity.indices(days)
         if self.follow_season:
             # Rounded to 2 days: the season moves the density by < 0.3% in 2 days.
             doy = np.clip(2.0 * np.round(day_of_year(days) / 2.0), 1.0, 366.0)
         else:
-            doy = np.zeros(samples)  # replaced by the year's nodes below
+            doy = np.zeros(days.size)  # replaced by the year's nodes below
         # Rounded so that repeated runs (bisections, batches) hit the cache: 0.1 sfu and 0.1 Ap
         # move the density by less than 0.1%.
         columns = (np.round(f107, 1), np.round(f107a, 1), np.round(ap, 1), doy)
         if not self.follow_season:
             nodes = (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
-            columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(nodes, samples))
-        daily = tuple(zip(*(c.tolist() for c in columns), strict=True))
-        return daily, bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step)
+            columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(nodes, days.size))
+        return tuple(zip(*(c.tolist() for c in columns), strict=True))
+
+    def log_ratios_by_day(self, first_day: int, count: int, binned: tuple[float, float]) -> FloatArray:
+        """`log_ratio` of each of ``count`` days from ``first_day`` (days after the start), shape (days, heights).
+
+        One NRLMSIS call for all of them (cached).
+        """
+        days = self.start_days + first_day + np.arange(count, dtype=np.float64)
+        per_day = 1 if self.follow_season else SEASON_NODES
+        return _log_ratios_by_day(
+            self.daily_indices(days), per_day, binned, float(self.inclination_deg), self.ascending_node_local_time_h
+        )
+
+    @staticmethod
+    def weight_of(curves: UniversalCurves, p_m: FloatArray, e: FloatArray) -> FloatArray:
+        """W left (`orbit_env.decay.curves.CurvePoint.weighted_s`) of the orbits (p, e) on ``curves``."""
+        return np.asarray(curves.locate(*heights_from_elements(p_m, e)).weighted_s, dtype=np.float64)
+
+    def log_ratio(self, daily: DailyIndices, binned: tuple[float, float]) -> FloatArray:
+        """ln(the mean density over ``daily`` / the bin's) on `RATIO_GRID_M` (cached)."""
+        return _log_ratio(daily, binned, float(self.inclination_deg), self.ascending_node_local_time_h)
 
     def bin_model(self, binned: tuple[float, float]) -> DecayModel:
         """The decay model of a bin (its atmosphere: NRLMSIS at the binned indices, year-averaged)."""
@@ -258,15 +320,19 @@ class SolarDecayModel:
         apogee_m: FloatArray,
         *,
         averaged: bool = False,
+        log_ratio: FloatArray | None = None,
     ) -> FloatArray:
         """The chunk's mean density over the bin's, over each orbit (the multiplier s).
 
         King-Hele's local form (`orbit_ratio`); with ``averaged``, for orbits wider than
-        `AVERAGED_MIN_X`, the ratio of the averaged equations' dp/dnu under the chunk's
-        profile (the bin's times the tabulated ratio) and under the bin's, with
-        `RATIO_QUADRATURE_POINTS` anomalies.
+        `AVERAGED_MIN_X`, the ratio of dW/dnu (W the life left on the bin's curves) under
+        the chunk's profile (the bin's times the tabulated ratio) and under the bin's,
+        from the averaged equations' dp/dnu and de/dnu with `RATIO_QUADRATURE_POINTS`
+        anomalies (the module docstring, step 3). ``log_ratio`` (on `RATIO_GRID_M`) replaces
+        the one of ``daily`` (`log_ratio`).
         """
-        log_ratio = _log_ratio(daily, binned, float(self.inclination_deg), self.ascending_node_local_time_h)
+        if log_ratio is None:
+            log_ratio = self.log_ratio(daily, binned)
         at_perigee = np.exp(np.interp(perigee_m, RATIO_GRID_M, log_ratio))
         ratio_slope = np.interp(perigee_m, RATIO_GRID_M, np.gradient(log_ratio, RATIO_GRID_M))
         atmosphere = self.bin_model(binned).atmosphere
@@ -281,13 +347,20 @@ class SolarDecayModel:
                 lambda h: atmosphere.density_kg_m3(h) * np.exp(np.interp(h, RATIO_GRID_M, log_ratio))
             )
             p, e = elements_from_heights(perigee_m[wide], apogee_m[wide])
-            rates = [
+            (dp_chunk, de_chunk), (dp_bin, de_bin) = (
                 DecayModel(air, self.rotating_atmosphere, self.inclination_deg, RATIO_QUADRATURE_POINTS).rates_per_nu(
                     p, e
-                )[0]
+                )
                 for air in (chunk, atmosphere)
-            ]
-            ratio[wide] = rates[0] / rates[1]
+            )
+            # dW/dt along the bin's curve is g c s: s weights the two rates by the gradient of W (the
+            # remaining life on the bin's curves) in (p, e), so that the life left falls at the chunk's rate
+            # although the orbit stays on the bin's curve (forward differences, towards higher perigees).
+            curves = cached_curves(self.bin_model(binned))
+            w0 = self.weight_of(curves, p, e)
+            w_p = (self.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
+            w_e = (w0 - self.weight_of(curves, p, e - GRADIENT_STEP_E)) / GRADIENT_STEP_E
+            ratio[wide] = (w_p * dp_chunk + w_e * de_chunk) / (w_p * dp_bin + w_e * de_bin)
         return ratio
 
 
@@ -341,7 +414,6 @@ def _daily_steps(
     model: SolarDecayModel,
     curves: UniversalCurves,
     binned: tuple[float, float],
-    daily: DailyIndices,
     label: FloatArray,
     nu: FloatArray,
     gcs: FloatArray,
@@ -349,40 +421,63 @@ def _daily_steps(
     ha: FloatArray,
     t0: float,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, tuple[list[float], list[FloatArray], list[FloatArray]]]:
-    """The chunk from ``t0`` one day (`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
+    """The chunk from ``t0`` a day (`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
 
-    Each day takes its own indices' density multiplier at that day's perigee. Returns the
-    re-entry day (NaN for a satellite still up at the chunk's end), nu and the heights at
-    the chunk's end (or at re-entry), and the sub-steps' times and heights (for the history).
+    Each step takes the density multiplier at its orbit of the profile at its middle: the
+    daily profiles' logarithms interpolated linearly in time, as `integrate_reference`
+    does. A satellite with less than `LAST_DAYS` left at the day's rate goes through
+    the day in `LAST_STEPS` steps. Returns the re-entry day (NaN for a satellite still
+    up at the chunk's end), nu and the heights at the chunk's end (or at re-entry), and
+    the days' ends and heights (for the history).
     """
-    samples = max(1, math.ceil(model.chunk_days))
-    per_sample = len(daily) // samples
+    first_day = math.floor(t0)
+    log_ratios = model.log_ratios_by_day(first_day, math.floor(t0 + model.chunk_days) + 2 - first_day, binned)
     steps = max(1, math.ceil(model.chunk_days / FINISH_STEP_DAYS))
     step_days = model.chunk_days / steps
     n = label.size
     days = np.full(n, np.nan)
     nu, hp, ha = nu.copy(), hp.copy(), ha.copy()
+
+    def rates(which: NDArray[np.intp], start: float, length: float) -> tuple[FloatArray, FloatArray]:
+        """W left and dW/dt of ``which`` in the step from ``start`` (days) of ``length`` days."""
+        middle = start + 0.5 * length - first_day
+        day = min(math.floor(middle), log_ratios.shape[0] - 2)
+        weight = middle - day
+        log_ratio = (1.0 - weight) * log_ratios[day] + weight * log_ratios[day + 1]
+        ratio = model.density_ratio((), binned, hp[which], ha[which], averaged=True, log_ratio=log_ratio)
+        _, _, w0 = _weight_at(curves, label[which], nu[which])
+        return w0, gcs[which] * ratio
+
+    def move(which: NDArray[np.intp], start: float, length: float, w0: FloatArray, rate: FloatArray) -> None:
+        target = w0 - rate * length * SECONDS_PER_DAY
+        ended = target <= 0.0
+        days[which[ended]] = start + w0[ended] / rate[ended] / SECONDS_PER_DAY
+        going = which[~ended]
+        if going.size:
+            nu[going] = _solve_nu(curves, label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
+            hp[going], ha[going], _ = _weight_at(curves, label[going], nu[going])
+        if ended.any():
+            nu[which[ended]] = 0.0
+            hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))
+
     alive = np.arange(n)
     times: list[float] = []
     heights_p: list[FloatArray] = []
     heights_a: list[FloatArray] = []
     for j in range(steps):
-        first = min(samples - 1, int(j * step_days * samples / model.chunk_days))
-        day = daily[first * per_sample : (first + 1) * per_sample]
-        ratio = model.density_ratio(day, binned, hp[alive], ha[alive], averaged=True)
-        _, _, w0 = _weight_at(curves, label[alive], nu[alive])
-        rate = gcs[alive] * ratio
-        target = w0 - rate * step_days * SECONDS_PER_DAY
-        ended = target <= 0.0
-        days[alive[ended]] = t0 + j * step_days + w0[ended] / rate[ended] / SECONDS_PER_DAY
-        going = alive[~ended]
-        if going.size:
-            nu[going] = _solve_nu(curves, label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
-            hp[going], ha[going], _ = _weight_at(curves, label[going], nu[going])
-        if ended.any():
-            nu[alive[ended]] = 0.0
-            hp[alive[ended]], ha[alive[ended]], _ = curves.at(label[alive[ended]], np.zeros(int(ended.sum())))
-        alive = going
+        start = t0 + j * step_days
+        w0, rate = rates(alive, start, step_days)
+        # In its last days the perigee falls tens of km a day: shorter steps let the multiplier follow the orbit.
+        last = w0 < rate * LAST_DAYS * SECONDS_PER_DAY
+        move(alive[~last], start, step_days, w0[~last], rate[~last])
+        close = alive[last]
+        for k in range(LAST_STEPS):
+            if close.size == 0:
+                break
+            sub_start = start + k * step_days / LAST_STEPS
+            move(close, sub_start, step_days / LAST_STEPS, *rates(close, sub_start, step_days / LAST_STEPS))
+            close = close[np.isnan(days[close])]
+        alive = alive[np.isnan(days[alive])]
         times.append(t0 + (j + 1) * step_days if alive.size else float(np.nanmax(days)))
         heights_p.append(hp.copy())
         heights_a.append(ha.copy())
@@ -463,7 +558,6 @@ def propagate(
                 model,
                 curves,
                 binned,
-                daily,
                 label[which],
                 nu0[which],
                 gcs[active[which]],
