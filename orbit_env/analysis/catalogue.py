@@ -23,18 +23,20 @@ With NRLMSIS the profile depends on the inclination (and in co-rotating air the
 drag does): rows are grouped by inclination rounded to ``INCLINATION_STEP_DEG``
 (1 deg moves a lifetime by about 0.5%, measured at 50 deg and 400 km, so rounding
 costs at most 0.25%). Up to ``MAX_FAMILIES`` groups get a curve family each (0.9 s
-to build). In a catalogue spread over more groups, the near-circular rows (apogee at
-most ``SPREAD_MAX_SPAN_M`` above perigee) take one family, that of their most common
-inclination, and each row's own inclination as a density multiplier along its decay:
-the ratio of NRLMSIS at the row's inclination to the family's (computed every
-``ANCHOR_STEP_DEG`` in one NRLMSIS call and interpolated in inclination, weighted over
-the orbit as drag weights it, `orbit_env.decay.chunked.orbit_ratio`), and of the
-co-rotating air's drag; the time is Int dW / (g c s) along the family's curve. On 10^4
-rows over 0-98 deg this costs 1.7 times one inclination and stays within 0.4% of a
-family per 1-degree group (``benchmarks/bench_catalogue.py``, docs/validation-modern.md
-section 7); wider orbits, a disposal rule and the time-stepped path keep a family per
-group. The paper's and the exponential law in still air do not depend on the
-inclination: one group.
+to build). In a catalogue spread over more groups, every row takes one family, that
+of the most common inclination, and its own inclination as a density multiplier along
+its decay: NRLMSIS at the row's inclination against the family's (computed every
+``ANCHOR_STEP_DEG`` in one NRLMSIS call and interpolated in inclination). Near-circular
+rows (apogee at most ``SPREAD_MAX_SPAN_M`` above perigee) take the ratio of the two
+densities weighted over the orbit as drag weights it
+(`orbit_env.decay.chunked.orbit_ratio`), times that of the co-rotating air's drag; wider
+rows the ratio of the rates at which the life left falls (``_life_rate_ratio``), which a
+profile of another shape moves through the eccentricity as well as the perigee. The time
+is Int dW / (g c s) along the family's curve. On 10^4 rows over 0-98 deg this stays
+within the 0.5% the curves hold of a family per 1-degree group, at the cost measured
+by ``benchmarks/bench_catalogue.py`` (docs/validation-modern.md section 7); a disposal
+rule and the time-stepped path keep a family per group. The paper's and the
+exponential law in still air do not depend on the inclination: one group.
 """
 
 from __future__ import annotations
@@ -75,8 +77,8 @@ FloatArray = NDArray[np.float64]
 INCLINATION_STEP_DEG = 1.0
 #: A catalogue with more inclination groups than this takes one curve family and a density ratio.
 MAX_FAMILIES = 2
-#: Widest orbit [m] (apogee - perigee height) on that path: the ratio is one multiplier for the perigee
-#: and the eccentricity decay alike, which holds for near-circular orbits (errors by width: validation-modern.md, 7).
+#: Widest orbit [m] (apogee - perigee height) that takes the density ratio over the orbit; wider ones the
+#: ratio of the life's rates (one multiplier moves the perigee and the eccentricity alike: validation-modern.md, 7).
 SPREAD_MAX_SPAN_M = 100e3
 #: Inclinations [deg] at which a spread catalogue's NRLMSIS ratio is computed (interpolated between).
 ANCHOR_STEP_DEG = 10.0
@@ -86,6 +88,10 @@ RATIO_HEIGHTS_M = np.arange(100e3, 1200e3 + 1.0, 25e3)
 RATIO_NODES = {"latitude_nodes": 12, "local_time_nodes": 6}
 #: Points along each decay (equal steps of the curves' tau) where the multiplier is taken.
 PATH_NODES = 48
+#: Points along each decay of a wide row (`_life_rate_ratio` is smoother than the density ratio, and costs more).
+WIDE_PATH_NODES = 32
+#: Anomalies of the wide rows' averaged rates (a ratio of two averages on the same nodes).
+WIDE_QUADRATURE_POINTS = 8
 #: Satellites per progress-bar step on the fixed-profile path.
 BLOCK = 20_000
 _ID_COLUMNS = ("name", "id")
@@ -261,14 +267,13 @@ def batch_lifetimes(
         and not exact_groups
         and groups.size > MAX_FAMILIES
     )
-    near_circular = ok & (apogee_m - perigee_m <= SPREAD_MAX_SPAN_M)
     by_groups = ok.copy()
     families: set[float] = set()
     with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
-        if one_family and near_circular.any():
+        if one_family:
             inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
-            families.add(_spread_batch(scenario, np.flatnonzero(near_circular), group_of, inputs, days, reentered, bar))
-            by_groups &= ~near_circular
+            families.add(_spread_batch(scenario, np.flatnonzero(ok), group_of, inputs, days, reentered, bar))
+            by_groups[:] = False
         for group in np.unique(group_of[by_groups]):
             families.add(float(group))
             members = np.flatnonzero(by_groups & (group_of == group))
@@ -371,34 +376,75 @@ def spread_lifetime_days(
 ) -> FloatArray:
     """Days to re-entry on the curves of ``reference_deg`` with each row's density multiplier along its decay.
 
-    Row k's multiplier at an orbit is exp(``log_ratio[k]``) at its height, weighted over
-    the orbit (`orbit_ratio`), times, in co-rotating air, the drag of the air's speed at
-    the perigee, ((v_p - Omega r_p cos i) / (v_p - Omega r_p cos i_ref))^2. The time is
-    Int dW / (g c s) along the reference curve, by the trapezoidal rule at ``PATH_NODES``
-    equal steps of tau; with s = 1 it is the curves' own lifetime exactly.
+    Row k's multiplier at an orbit is its profile's (the reference's times
+    exp(``log_ratio[k]``) at each height) over the reference's: for near-circular
+    rows (apogee at most `SPREAD_MAX_SPAN_M` above perigee) the ratio weighted over
+    the orbit (`orbit_ratio`), for wider rows the ratio of the rates at which the life
+    left falls (``_life_rate_ratio``); in co-rotating air times the drag of the air's
+    speed at the perigee, ((v_p - Omega r_p cos i) / (v_p - Omega r_p cos i_ref))^2.
+    The time is Int dW / (g c s) along the reference curve, by the trapezoidal rule at
+    `PATH_NODES` (`WIDE_PATH_NODES`) equal steps of tau; with s = 1 it is the curves'
+    own lifetime exactly.
     """
+    perigee_m, apogee_m = np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64)
+    days = np.empty(perigee_m.size)
+    wide = apogee_m - perigee_m > SPREAD_MAX_SPAN_M
+    for rows, nodes in ((np.flatnonzero(~wide), PATH_NODES), (np.flatnonzero(wide), WIDE_PATH_NODES)):
+        if rows.size:
+            days[rows] = _spread_days(
+                curves,
+                scenario,
+                reference_deg,
+                log_ratio[rows],
+                np.asarray(inclination_deg, dtype=np.float64)[rows],
+                perigee_m[rows],
+                apogee_m[rows],
+                np.asarray(drag_parameter_m2_kg, dtype=np.float64)[rows],
+                nodes,
+                wide=nodes == WIDE_PATH_NODES,
+            )
+    return days
+
+
+def _spread_days(
+    curves: UniversalCurves,
+    scenario: Scenario,
+    reference_deg: float,
+    log_ratio: FloatArray,
+    inclination_deg: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    drag_parameter_m2_kg: FloatArray,
+    nodes: int,
+    *,
+    wide: bool,
+) -> FloatArray:
+    """`spread_lifetime_days` of rows all near-circular or all wide (``wide``), at ``nodes`` steps."""
     point = curves.locate(perigee_m, apogee_m)
-    steps = np.linspace(0.0, 1.0, PATH_NODES + 1)
+    steps = np.linspace(0.0, 1.0, nodes + 1)
     tau = point.tau[:, None] * steps[None, :]
     label = np.broadcast_to(point.label[:, None], tau.shape)
     hp, ha, q = curves.at(label, tau)
     weighted = q * (NU_REF * np.expm1(tau))
-    dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
-    x = np.clip((hp - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
-    cell = x.astype(np.intp)
-    frac = x - cell
-    rows = np.arange(hp.shape[0])[:, None]
-    low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
-    ratio = np.exp(low + frac * (high - low))
-    if scenario.atmosphere == "msis":
-        from orbit_env.decay.chunked import log_density_slope_per_m
-        from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
+    if wide:
+        ratio = _life_rate_ratio(curves, log_ratio, inclination_deg, hp, ha, weighted)
+    else:
+        dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
+        x = np.clip((hp - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
+        cell = x.astype(np.intp)
+        frac = x - cell
+        rows = np.arange(hp.shape[0])[:, None]
+        low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
+        ratio = np.exp(low + frac * (high - low))
+        if scenario.atmosphere == "msis":
+            from orbit_env.decay.chunked import log_density_slope_per_m
+            from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
 
-        atmosphere = curves.model.atmosphere
-        assert isinstance(atmosphere, MsisAtmosphere)
-        density_slope = np.interp(hp, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
-        ratio = orbit_ratio(ratio, (high - low) / dh, density_slope, hp, ha)
-    if scenario.rotating_atmosphere:
+            atmosphere = curves.model.atmosphere
+            assert isinstance(atmosphere, MsisAtmosphere)
+            density_slope = np.interp(hp, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
+            ratio = orbit_ratio(ratio, (high - low) / dh, density_slope, hp, ha)
+    if scenario.rotating_atmosphere and not wide:  # the wide rows' rates carry their air's speed
         p, e = elements_from_heights(hp, ha)
         r_p = EARTH_RADIUS_M + hp
         v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
@@ -408,6 +454,68 @@ def spread_lifetime_days(
     inverse = 1.0 / ratio
     time_gcs = np.sum(np.diff(weighted, axis=1) * 0.5 * (inverse[:, 1:] + inverse[:, :-1]), axis=1)
     return np.asarray(time_gcs / (G0_M_S2 * drag_parameter_m2_kg * scenario.density_scale) / SECONDS_PER_DAY)
+
+
+def _life_rate_ratio(
+    curves: UniversalCurves,
+    log_ratio: FloatArray,
+    inclination_deg: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    weighted: FloatArray,
+) -> FloatArray:
+    """dW/dnu of each row's air over the reference's, at orbits (rows, nodes) on the reference curves.
+
+    W is the life left on the reference curves (times g c), ``weighted`` at these orbits.
+    The orbit stays on the reference curve, so what must be right is how fast W falls:
+    W_p p' + W_e e' with the averaged equations' rates p', e' (`WIDE_QUADRATURE_POINTS`
+    anomalies) under the row's profile (in co-rotating air, at the row's inclination),
+    over the same under the reference's. One
+    multiplier of the density at the perigee (`orbit_ratio`) moves p and e alike,
+    where a profile of another shape moves the eccentricity otherwise: on orbits 100-1500
+    km wide it came out up to 2.3% off a family per inclination, this within 0.5%
+    (docs/validation-modern.md, section 7). The gradient of W by forward differences
+    (those of `orbit_env.decay.chunked`), towards higher perigees; at re-entry
+    (the first node) the next node's ratio.
+    """
+    from orbit_env.decay.averaged import DecayModel
+    from orbit_env.decay.chunked import GRADIENT_STEP_E, GRADIENT_STEP_P_M, SolarDecayModel
+    from orbit_env.physics.atmosphere import FunctionAtmosphere
+
+    model = curves.model
+    reference = model.atmosphere
+    dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
+    rows = np.arange(perigee_m.shape[0])[:, None, None]
+
+    def row_density(h: FloatArray) -> FloatArray:
+        # h is (rows, nodes, anomalies): each row reads its own log-ratio table.
+        x = np.clip((h - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
+        cell = x.astype(np.intp)
+        low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
+        return np.asarray(reference.density_kg_m3(h) * np.exp(low + (x - cell) * (high - low)), dtype=np.float64)
+
+    p, e = elements_from_heights(perigee_m, apogee_m)
+    e = np.maximum(e, 0.0)
+    if model.rotating_atmosphere:
+        # The air's speed (Omega r cos i) enters the rates nonlinearly but smoothly (Omega r / v < 0.07):
+        # rates at cos i = -1, 0, 1 and each row's cos i by the parabola through them.
+        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))[:, None]
+        weights = (0.5 * cos_i * (cos_i - 1.0), 1.0 - cos_i * cos_i, 0.5 * cos_i * (cos_i + 1.0))
+        nodes_deg = (180.0, 90.0, 0.0)
+    else:
+        weights, nodes_deg = (np.ones((perigee_m.shape[0], 1)),), (model.inclination_deg,)
+    dp_row, de_row = np.zeros(perigee_m.shape), np.zeros(perigee_m.shape)
+    for weight, node in zip(weights, nodes_deg, strict=True):
+        air = FunctionAtmosphere(row_density)
+        node_dp, node_de = DecayModel(air, model.rotating_atmosphere, node, WIDE_QUADRATURE_POINTS).rates_per_nu(p, e)
+        dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
+    own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, WIDE_QUADRATURE_POINTS)
+    dp_ref, de_ref = own.rates_per_nu(p, e)
+    w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - weighted) / GRADIENT_STEP_P_M
+    w_e = (weighted - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
+    ratio = (w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref)
+    ratio[:, 0] = ratio[:, 1]
+    return np.asarray(ratio, dtype=np.float64)
 
 
 def _fmt(value: float) -> str:
