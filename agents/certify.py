@@ -215,6 +215,7 @@ def certify(
     perturbations: int = 24,
     policy: Predictor | None = None,
     dp_lookahead: int = 1,
+    dp_rollout: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> Certificate:
     """Search for plans that beat the DP policy on ``episodes`` seeded starts (see the module).
@@ -227,6 +228,7 @@ def certify(
         perturbations: Random changes tried per start and round.
         policy: The policy to certify (default: the env's DP policy).
         dp_lookahead: The DP policy's ``lookahead`` (`orbit_env.agents.dp.DPPolicy`).
+        dp_rollout: Certify the rollout policy on the DP (`orbit_env.agents.evaluate.dp_policy`).
         progress: Called with a line of text as the search goes.
 
     Raises:
@@ -250,7 +252,7 @@ def certify(
     everyone = np.arange(episodes)
     say("dp (solving and playing)")
     dp_returns, dp_burns = plans.score(
-        everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id, dp_lookahead)
+        everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id, dp_lookahead, dp_rollout)
     )
     best, best_returns = dp_burns.copy(), dp_returns.copy()
     early = _early_plans(plans)

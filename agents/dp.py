@@ -702,6 +702,115 @@ def _backward_induction(
     return solution
 
 
+#: Steps from the mission's start in which the rollout policy decides by rollouts; later, and
+#: wherever the tank is empty or coasting is proven optimal, it acts as the base DP policy.
+ROLLOUT_STEPS = 20
+#: The base policy's burns recorded per rollout for the burn-early continuations.
+ROLLOUT_MAX_BURNS = 16
+#: A candidate replaces the base policy's action only if it earns more than this [days].
+ROLLOUT_TIE_DAYS = 1e-9
+
+
+def _no_choice(solution: DPSolution, states: BatchState, steps_left: NDArray[np.intp]) -> NDArray[np.bool_]:
+    """States with nothing to decide: an empty tank, or a satellite that outlives the mission coasting.
+
+    Coasting is proven optimal there up to the stage ``_coast_certain`` (see the module).
+    """
+    task = solution._model.task
+    outlives = (steps_left <= solution._coast_certain) & task_model.outlives(task, states, steps_left)
+    return (states.dv_left_m_s <= 0.0) | outlives
+
+
+def _base_burns(solution: DPSolution, states: BatchState, steps_left: NDArray[np.intp]) -> FloatArray:
+    """The base DP policy's burns [m/s]: argmax_a r_a + V_{k-1}(successor_a)."""
+    sizes = np.asarray(solution.config.burn_sizes_m_s, dtype=np.float64)
+    return sizes[np.argmax(solution.q_values(states, steps_left), axis=1)]
+
+
+def rollout_returns(
+    solution: DPSolution,
+    states: BatchState,
+    prefix_m_s: FloatArray,
+    steps_left: NDArray[np.intp],
+    last_step: float = np.inf,
+) -> FloatArray:
+    """Exact returns of burning ``prefix_m_s`` (rows, m) on the next m steps, then the best continuation.
+
+    The continuations, played in the task model (no interpolation): the base DP policy
+    to the end (a choice only while there is one, `_no_choice`; then the coasts' days
+    summed exactly), and the base policy's first j burns on consecutive steps, then
+    coasting, for j = 0, 1, ... (the base's deferred burns brought forward), among
+    those whose burns end before step ``last_step`` (after it the rollout policy acts
+    as the base). ``states`` is not changed.
+
+    Args:
+        solution: The base policy's DP solution.
+        states: The states (n satellites).
+        prefix_m_s: The burns to make first, shape (n, m) [m/s].
+        steps_left: Steps left in the mission, shape (n,).
+        last_step: Burns of the burn-early continuations happen before this step.
+
+    Returns:
+        The returns [days], shape (n,).
+    """
+    task = solution._model.task
+    s = states.copy()
+    k = np.asarray(steps_left, dtype=np.intp).copy()
+    total = np.zeros(s.size)
+    for column in np.asarray(prefix_m_s, dtype=np.float64).reshape(s.size, -1).T:
+        going = (s.tau > 0.0) & (k > 0)
+        result = task_model.step(task, s, np.where(going, column, 0.0))
+        total += np.where(going, result.reward, 0.0)
+        k -= going
+    origin, origin_k, origin_total = s.copy(), k.copy(), total.copy()
+    burns = np.zeros((s.size, ROLLOUT_MAX_BURNS))
+    count = np.zeros(s.size, np.intp)
+    alive = (s.tau > 0.0) & (k > 0)
+    done = alive & _no_choice(solution, s, k)
+    if done.any():
+        total[done] += task_model.lookahead(task, s.take(done), 0.0, k[done])[0]
+    active = np.flatnonzero(alive & ~done)
+    while active.size:
+        # The base policy on the satellites that still have a choice, all at the same stages
+        # when the states came from one step of a vector env (one stage read per step).
+        batch = s.take(active)
+        result = task_model.step(task, batch, _base_burns(solution, batch, k[active]))
+        total[active] += result.reward
+        burned = (np.asarray(result.burn_m_s) > 0.0) & (count[active] < ROLLOUT_MAX_BURNS)
+        recorded = active[burned]
+        burns[recorded, count[recorded]] = np.asarray(result.burn_m_s)[burned]
+        count[recorded] += 1
+        k[active] -= 1
+        s.put(active, batch)
+        alive = (batch.tau > 0.0) & (k[active] > 0)
+        done = alive & _no_choice(solution, batch, k[active])
+        if done.any():
+            finished = active[done]
+            total[finished] += task_model.lookahead(task, batch.take(done), 0.0, k[finished])[0]
+        active = active[alive & ~done]
+    # The burn-early continuations, grown one burn at a time: after j burns, coast to the end.
+    rows = np.flatnonzero((origin.tau > 0.0) & (origin_k > 0))
+    early, early_k, early_total = origin.take(rows), origin_k[rows], origin_total[rows]
+    room = last_step - origin.steps[rows]
+    for j in range(int(count.max(initial=0)) + 1):
+        coasting = task_model.lookahead(task, early, 0.0, early_k)[0]
+        np.maximum.at(total, rows, early_total + coasting)
+        more = (count[rows] > j) & (room > j) & (early.tau > 0.0) & (early_k > 0)
+        if not more.any():
+            break
+        rows, early, early_k, early_total, room = (
+            rows[more],
+            early.take(more),
+            early_k[more],
+            early_total[more],
+            room[more],
+        )
+        result = task_model.step(task, early, burns[rows, j])
+        early_total = early_total + result.reward
+        early_k = early_k - 1
+    return total
+
+
 class DPPolicy:
     """The optimum's policy, in Stable-Baselines3's ``predict`` protocol.
 
@@ -720,6 +829,18 @@ class DPPolicy:
             interpolation enters one step later. On 200 evaluation starts
             (``orbit-env evaluate --certify``'s search) 2 halves the mean gap found, from
             0.047 to 0.025 day (worst 1.49 to 1.15 days), with four q-value evaluations per step.
+        rollout: 0 (the default): act on the grid's values as ``lookahead`` says. 1 or 2:
+            a rollout policy on the one-step DP policy (the base): in the first
+            ``rollout_steps`` steps, wherever there is a choice, every action (1) or every
+            pair of actions on the next two steps (2) is played in the task model and
+            followed by the best of the base policy to the end and the base's burns
+            brought forward (`rollout_returns`), all exact; the first action of the best
+            is taken. Deterministic: it earns at least the base's return from the state it
+            plans from, up to the continuations it cannot follow later (see docs/dp.md).
+        rollout_steps: The steps from the mission's start in which the rollout decides.
+        refine_m_s: With ``rollout``, burn sizes off the config's: after the best of the
+            config's burns, b +- h for each h in turn (clipped to 0..max burn) replaces it
+            where it earns more (the continuous variant).
     """
 
     name = "dp"
@@ -732,12 +853,87 @@ class DPPolicy:
         density_scale: float = 1.0,
         solution: DPSolution | None = None,
         lookahead: int = 1,
+        rollout: int = 0,
+        rollout_steps: int = ROLLOUT_STEPS,
+        refine_m_s: tuple[float, ...] = (),
     ) -> None:
         if lookahead not in (1, 2):
             raise ValueError(f"lookahead={lookahead!r} is invalid; allowed: 1 or 2")
+        if rollout not in (0, 1, 2) or isinstance(rollout, bool):
+            raise ValueError(f"rollout={rollout!r} is invalid; allowed: 0, 1 or 2")
+        if rollout and lookahead != 1:
+            raise ValueError(
+                f"lookahead={lookahead!r} with rollout={rollout!r}: the rollout's base looks one step ahead"
+            )
+        if not (isinstance(rollout_steps, (int, np.integer)) and rollout_steps >= 0):
+            raise ValueError(f"rollout_steps={rollout_steps!r} is invalid; allowed: an integer >= 0")
+        refine = tuple(float(h) for h in refine_m_s)
+        if not all(math.isfinite(h) and h > 0.0 for h in refine) or (refine and not rollout):
+            raise ValueError(f"refine_m_s={refine_m_s!r} is invalid; allowed: sizes > 0 [m/s], with rollout")
         self.solution = solution if solution is not None else solve(config, grid=grid, density_scale=density_scale)
         self.config = self.solution.config
         self.lookahead = lookahead
+        self.rollout = int(rollout)
+        self.rollout_steps = int(rollout_steps)
+        self.refine_m_s = refine
+
+    def burns_m_s(self, observation: Any) -> FloatArray:
+        """The burns chosen for a batch of observations (n, 7) or one (7,), as an array (n,) [m/s]."""
+        sizes = np.asarray(self.config.burn_sizes_m_s, dtype=np.float64)
+        states = task_model.decode(self.solution._model.task, observation)
+        steps_left = (self.config.horizon_steps - states.steps).astype(np.intp)
+        if self.lookahead == 1:
+            q = self.solution.q_values(states, steps_left)
+        else:
+            q = np.empty((states.size, sizes.size))
+            for a, burn in enumerate(self.config.burn_sizes_m_s):
+                step = self.solution._model.step(states, burn)
+                q[:, a] = step.reward + self.solution.q_values(step.state, steps_left - 1).max(axis=1)
+            q[(steps_left <= 0) | (states.tau <= 0.0)] = 0.0
+        burns = sizes[np.argmax(q, axis=1)]
+        if self.rollout:
+            deciding = (steps_left > 0) & (states.tau > 0.0) & (states.steps < self.rollout_steps)
+            rows = np.flatnonzero(deciding & ~_no_choice(self.solution, states, steps_left))
+            if rows.size:
+                burns[rows] = self._improve(states.take(rows), steps_left[rows], burns[rows])
+        return burns
+
+    def _improve(self, states: BatchState, steps_left: NDArray[np.intp], base_m_s: FloatArray) -> FloatArray:
+        """The rollout's burns: the best first burn of the candidates (the base's where none earns more)."""
+        sizes = np.asarray(self.config.burn_sizes_m_s, dtype=np.float64)
+        n, m = states.size, sizes.size
+        prefixes = sizes[:, None] if self.rollout == 1 else np.stack(np.meshgrid(sizes, sizes, indexing="ij"), -1)
+        prefixes = prefixes.reshape(-1, self.rollout)
+        per_row = prefixes.shape[0]
+        every = np.arange(n)
+        returns = rollout_returns(
+            self.solution,
+            states.take(np.repeat(every, per_row)),
+            np.tile(prefixes, (n, 1)),
+            np.repeat(steps_left, per_row),
+            self.rollout_steps,
+        ).reshape(n, m, -1)
+        first = returns.max(axis=2)
+        base = np.abs(base_m_s[:, None] - sizes).argmin(axis=1)
+        best = np.argmax(first, axis=1)
+        value = first[every, base]
+        better = first[every, best] > value + ROLLOUT_TIE_DAYS
+        choice = np.where(better, sizes[best], base_m_s)
+        value = np.where(better, first[every, best], value)
+        for h in self.refine_m_s:
+            candidates = np.clip(choice[:, None] + np.array([-h, h]), 0.0, self.config.max_burn_m_s)
+            found = rollout_returns(
+                self.solution,
+                states.take(np.repeat(every, 2)),
+                candidates.reshape(-1, 1),
+                np.repeat(steps_left, 2),
+                self.rollout_steps,
+            ).reshape(n, 2)
+            j = np.argmax(found, axis=1)
+            better = found[every, j] > value + ROLLOUT_TIE_DAYS
+            choice = np.where(better, candidates[every, j], choice)
+            value = np.where(better, found[every, j], value)
+        return choice
 
     def predict(
         self,
@@ -746,16 +942,11 @@ class DPPolicy:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[Any, Any]:
-        """Actions for one observation (7,) or a batch (n, 7); SB3's signature."""
-        states = task_model.decode(self.solution._model.task, observation)
-        steps_left = (self.config.horizon_steps - states.steps).astype(np.intp)
-        if self.lookahead == 1:
-            q = self.solution.q_values(states, steps_left)
-        else:
-            q = np.empty((states.size, len(self.config.burn_sizes_m_s)))
-            for a, burn in enumerate(self.config.burn_sizes_m_s):
-                step = self.solution._model.step(states, burn)
-                q[:, a] = step.reward + self.solution.q_values(step.state, steps_left - 1).max(axis=1)
-            q[(steps_left <= 0) | (states.tau <= 0.0)] = 0.0
-        actions = np.argmax(q, axis=1).astype(np.int64)
+        """Actions for one observation (7,) or a batch (n, 7); SB3's signature.
+
+        The index of the config's burn size nearest the chosen burn (the burn itself,
+        off the config's sizes with ``refine_m_s``: see `burns_m_s`).
+        """
+        burns = self.burns_m_s(observation)
+        actions = np.abs(burns[:, None] - np.asarray(self.config.burn_sizes_m_s)).argmin(axis=1).astype(np.int64)
         return (actions[0] if np.ndim(observation) == 1 else actions), state

@@ -254,3 +254,92 @@ def test_a_two_step_lookahead_acts_and_checks_its_argument():
     np.testing.assert_array_equal(policy.predict(empty)[0], one.predict(empty)[0])
     with pytest.raises(ValueError, match="lookahead=3 is invalid"):
         dp.DPPolicy(CONFIG, grid=GRID, lookahead=3)
+
+
+def replay(config, seed, burns_m_s, then):
+    """The return in ``gym.make`` of the burns ``burns_m_s`` on the first steps, then ``then(state)``'s burns.
+
+    ``then`` gets the env's own state as a planning state: at its curve coordinates (label,
+    tau; locating its heights again would move them by up to some 30 m).
+    """
+    env = gym.make("OrbitRaising-v0", config=config, max_episode_steps=config.horizon_steps)
+    env.reset(seed=seed)
+    task = env.unwrapped.task
+    sizes = list(config.burn_sizes_m_s)
+    total, done, t = 0.0, False, 0
+    while not done:
+        if t < len(burns_m_s):
+            burn = burns_m_s[t]
+        else:
+            s = env.unwrapped.state
+            dv_left = task_model.delta_v_left_m_s(s["mass_kg"], config.dry_mass_kg, config.exhaust_velocity_m_s)
+            burn = then(task_model.states_on_curves(task, s["label"], s["tau"], dv_left, t))
+        _, reward, terminated, truncated, _ = env.step(sizes.index(burn))
+        total, done, t = total + reward, terminated or truncated, t + 1
+    return total
+
+
+def test_the_rollouts_returns_are_the_envs_for_the_plans_they_play(solution):
+    # rollout_returns: the prefix, then the better of the base policy (coasting once there is
+    # no choice) and coasting (last_step=0: no burn brought forward), all in the task model.
+    def base_then_coast(states):
+        k = (CONFIG.horizon_steps - states.steps).astype(np.intp)
+        return 0.0 if dp._no_choice(solution, states, k)[0] else float(dp._base_burns(solution, states, k)[0])
+
+    prefixes = [(30.0, 0.0), (0.0, 10.0), (100.0, 100.0), (0.0, 0.0)]
+    for seed in range(8):
+        env = gym.make("OrbitRaising-v0", config=CONFIG)
+        env.reset(seed=seed)
+        s = env.unwrapped.state
+        states = task_model.states_on_curves(env.unwrapped.task, s["label"], s["tau"], CONFIG.delta_v_capacity_m_s, 0.0)
+        got = dp.rollout_returns(
+            solution,
+            states.take(np.zeros(len(prefixes), np.intp)),
+            np.array(prefixes),
+            np.full(len(prefixes), CONFIG.horizon_steps),
+            last_step=0,
+        )
+        for prefix, value in zip(prefixes, got, strict=True):
+            expected = max(replay(CONFIG, seed, prefix, base_then_coast), replay(CONFIG, seed, prefix, lambda _: 0.0))
+            # The same task functions on the same states, on arrays and on the single env's floats:
+            # equal up to round-off (measured 2e-13 day).
+            assert value == pytest.approx(expected, abs=1e-9)
+
+
+def test_the_rollout_policy_earns_at_least_the_dp_policys_return_from_elongated_orbits():
+    # The 180-step task from elongated orbits, where the base policy on this coarse grid falls
+    # up to 1.8 days short of its own value (above). The rollout improves on the base from every
+    # state it plans from (deterministic task); it plans from the decoded observation, so allow
+    # 1e-3 day (the decode's float32 heights move returns by ~1e-5 day).
+    solution = solve(LONG, grid=(64, 1, 1))
+    base = DPPolicy(solution=solution)
+    rollout = DPPolicy(solution=solution, rollout=2)
+    base_returns, _ = run_vector(LONG, lambda obs: base.predict(obs)[0], episodes=32)
+    rollout_returns, _ = run_vector(LONG, lambda obs: rollout.predict(obs)[0], episodes=32)
+    gain = rollout_returns - base_returns
+    assert gain.min() >= -1e-3
+    # ... and it is not the base: it finds better plans on many starts (measured: never worse,
+    # 14 of 32 starts better by more than 0.05 day, up to 0.86, 0.17 on average).
+    assert np.sum(gain > 0.05) >= 5 and gain.mean() > 0.05
+
+
+def test_the_rollout_policy_checks_its_arguments_and_acts_in_the_discrete_space(solution):
+    policy = DPPolicy(solution=solution, rollout=1, rollout_steps=5)
+    env = gym.make_vec("OrbitRaising-v0", num_envs=8, config=CONFIG)
+    obs, _ = env.reset(seed=2)
+    actions, _ = policy.predict(obs)
+    assert actions.shape == (8,) and actions.dtype == np.int64
+    assert policy.predict(obs[0])[0] == actions[0]
+    # Past its steps it acts as the base policy.
+    late = obs.copy()
+    late[:, 3] = 10 / CONFIG.horizon_steps
+    np.testing.assert_array_equal(policy.predict(late)[0], DPPolicy(solution=solution).predict(late)[0])
+    for kwargs, match in (
+        ({"rollout": 3}, "rollout=3 is invalid"),
+        ({"rollout": 1, "lookahead": 2}, "lookahead=2 with rollout=1"),
+        ({"refine_m_s": (5.0,)}, "refine_m_s"),
+        ({"rollout": 1, "refine_m_s": (-1.0,)}, "refine_m_s"),
+        ({"rollout": 1, "rollout_steps": -1}, "rollout_steps"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            DPPolicy(solution=solution, **kwargs)

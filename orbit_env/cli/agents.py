@@ -59,6 +59,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         progress=say,
         warn=warn,
         dp_lookahead=args.dp_lookahead,
+        dp_rollout=args.dp_rollout,
     )
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
@@ -82,7 +83,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 def _certify(args: argparse.Namespace, say: Any) -> int:
     from orbit_env.agents.certify import certify, format_certificate
 
-    certificate = certify(args.env, args.episodes, args.seed, dp_lookahead=args.dp_lookahead, progress=say)
+    certificate = certify(
+        args.env, args.episodes, args.seed, dp_lookahead=args.dp_lookahead, dp_rollout=args.dp_rollout, progress=say
+    )
     summary = certificate.summary()
     print(json.dumps(summary) if args.json else format_certificate(summary))
     return 0
@@ -151,6 +154,11 @@ def add_parsers(sub: Any) -> None:
         choices=(1, 2),
         default=1,
         help="steps the DP policy takes exactly before reading its grid (default 1; 2 is closer to the optimum)",
+    )
+    ev.add_argument(
+        "--dp-rollout",
+        action="store_true",
+        help="the DP row is the rollout policy on the DP: certified, slower (see docs/dp.md)",
     )
     ev.add_argument(
         "--certify",
