@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from orbit_env.agents.certify import certify
-from orbit_env.agents.evaluate import run_episodes
+from orbit_env.agents.evaluate import dp_policy, run_episodes
 from orbit_env.agents.policies import Greedy, NeverBurn
 
 
@@ -48,6 +48,9 @@ def test_certify_refuses_an_unknown_density_and_the_cli_prints_json(capsys):
 
     assert main(["evaluate", "--certify", "--env", "OrbitRaisingUncertain-v0"]) == 2
     assert "known, constant density" in capsys.readouterr().err
+    # The rollout plays the DP's task model: not with a hidden density (its optimum is the oracle's).
+    with pytest.raises(ValueError, match="rollout needs a known, constant density"):
+        dp_policy("OrbitRaisingUncertain-v0", rollout=True)
 
 
 def test_certify_summary_is_json():
