@@ -57,7 +57,9 @@ on the default grid), and the solution is kept in the disk cache
 (`orbit_env.cache`), so it is solved again only when its inputs change. The policy acts by the same one-step
 look-ahead from the state recovered from the observation: argmax_a r_a(s) +
 V_{k-1}(successor), with V_{k-1} interpolated, or the exact sum of the coasts'
-days where the successor outlives the mission.
+days where the successor outlives the mission. ``DPPolicy(rollout=2)`` is the rollout
+policy on that one (`rollout_returns`): early decisions taken by playing the candidates
+and the base policy to the end in the task model, exact, with no interpolation.
 
 Grid refinement on the 200 evaluation episodes of ``orbit-env evaluate``
 (seed 12345; default config, density scale 1): "value" is the mean of
