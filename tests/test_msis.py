@@ -184,8 +184,9 @@ def test_the_days_ratios_in_one_call_equal_each_days_own(follow_season):
 
 
 # 12-day lives that the chunked decay put 0.81% and 0.65% off the daily reference with each day's indices
-# held over the day, one step a day and, on the wide orbit, the ratio of dp/dnu alone (measured -0.06% and
-# -0.35% now, `python benchmarks/measure_chunking.py short`). The stated accuracy for 10 days and more: 0.5%.
+# held over the day, one step a day and, on the wide orbit, the ratio of dp/dnu alone (measured -0.05% and
+# -0.34% now; the 108 cases of `python benchmarks/measure_chunking.py short`: validation-modern.md, section 3).
+# The stated accuracy for 10 days and more: 0.5%.
 @pytest.mark.parametrize(
     ("date", "perigee_km", "apogee_km"),
     [("2001-10-28", 289.0, 289.0), ("2003-10-20", 229.0, 349.0)],

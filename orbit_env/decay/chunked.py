@@ -48,7 +48,7 @@ satellites through time in chunks (``chunk_days``, default 20 days); in each chu
    (`LAST_STEPS`), so the last weeks are resolved (and recorded) day by day. The
    days' ratios come from one NRLMSIS call per chunk. With each day's indices held
    over the day and one step a day, lives of 10-20 days came out up to 0.81% off
-   the daily reference (9 of 36 above 0.5%), and within 0.36% so
+   the daily reference (9 of 36 above 0.5%), and within 0.35% so
    (docs/validation-modern.md).
 
 Satellites are re-located on the curves only when the bin changes. Everything is
