@@ -118,8 +118,9 @@ def test_sine() -> None:
     period_days = 365.0
     time_days = x * (period_days / TWO_PI)
     angle = TWO_PI * time_days / period_days  # the loop's angle, as it computes it (phase 0)
-    parameters = np.zeros(6)
-    parameters[4:] = 1.0, period_days  # amplitude 1: the exponent is the sine itself
+    parameters = np.zeros(12)
+    parameters[kernel_module._AMPLITUDE] = 1.0  # the exponent is the sine itself
+    parameters[kernel_module._PERIOD_DAYS] = period_days
     near, far = slice(0, -3), slice(-3, None)
     for part in (near, far):
         out = np.empty(time_days[part].size)

@@ -55,8 +55,9 @@ _SEGMENT = 20  # then the cell of table B: j, three bases, three slopes
 
 # Parameters of one table's grid, in a float array (see `_grid_parameters`).
 _NY, _X_SCALE, _X_OFFSET, _Y_SCALE, _Y_OFFSET, _X_TOP, _Y_TOP = range(7)
-# Parameters of the task, in a float array (see `_task_parameters`).
-_NOMINAL_S_DAY, _VARIES, _AMPLITUDE, _PERIOD_DAYS = range(4)
+# Parameters of the task, in a float array (`orbit_env.envs.task.kernel_parameters`).
+_REVOLUTIONS, _COST, _HORIZON, _NOMINAL_S_DAY, _VARIES, _AMPLITUDE, _PERIOD_DAYS = range(7)
+_HEIGHT_SCALE, _DV_SCALE, _LIFETIME_SCALE, _APOGEE_DROP_SCALE, _PERIGEE_DROP_SCALE = range(7, 12)
 
 
 def _cell(cells: FloatArray, grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]:
@@ -135,6 +136,11 @@ def _update_density(data: FloatArray, k: int, p: FloatArray) -> None:
     if p[_VARIES] != 0.0:
         angle = TWO_PI * data[_TIME, k] / p[_PERIOD_DAYS] + data[_PHASE, k]
         scale = scale * math.exp(p[_AMPLITUDE] * math.sin(angle))
+    _set_density_scale(data, k, scale)
+
+
+def _set_density_scale(data: FloatArray, k: int, scale: float) -> None:
+    """Row ``k``'s density scale s(t) and its g c s per revolution (`task.update_density`'s last lines)."""
     data[_SCALE, k] = scale
     data[_NU_PER_REV, k] = G0_M_S2 * (data[_AREA, k] / data[_MASS, k] * scale)
 
@@ -190,10 +196,6 @@ def _burn_rows(
         made[k] = _burn(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
 
 
-# Parameters of a coast and its observation, in a float array (`coast_parameters`).
-_REVOLUTIONS, _COST, _HORIZON, _C_VARIES, _C_AMPLITUDE, _C_PERIOD_DAYS = range(6)
-_HEIGHT_SCALE, _DV_SCALE, _LIFETIME_SCALE, _APOGEE_DROP_SCALE, _PERIGEE_DROP_SCALE = range(6, 11)
-
 # fdlibm's reduction by pi/2 (e_rem_pio2.c: 33 bits of pi/2, and the rest) and its sine and cosine
 # polynomials on [-pi/4, pi/4] (k_sin.c, k_cos.c).
 _INV_PIO2 = 6.36619772367581382433e-01
@@ -227,7 +229,7 @@ def _sine(x: float) -> float:
 def _modulation_exponents(time_days: FloatArray, phase_rad: FloatArray, p: FloatArray, out: FloatArray) -> None:
     """A sin(2 pi t / T + phi) of every satellite: the exponent of `task.density_scale_at`."""
     # Locals, not reads of p in the loop: ``out`` could alias p, which would keep the loop scalar.
-    amplitude, period_days = p[_C_AMPLITUDE], p[_C_PERIOD_DAYS]
+    amplitude, period_days = p[_AMPLITUDE], p[_PERIOD_DAYS]
     beyond = 0  # an integer count: a float reduction would not vectorize without fast-math
     for k in range(time_days.size):
         angle = TWO_PI * time_days[k] / period_days + phase_rad[k]
@@ -244,10 +246,8 @@ def _coast_start(data: FloatArray, p: FloatArray, modulation: FloatArray, nu_aft
     ``x`` gets nu / NU_REF, whose log1p is the new tau (`UniversalCurves._after`).
     """
     for k in range(data.shape[1]):
-        if p[_C_VARIES] != 0.0:
-            scale = data[_BASE, k] * modulation[k]
-            data[_SCALE, k] = scale
-            data[_NU_PER_REV, k] = G0_M_S2 * (data[_AREA, k] / data[_MASS, k] * scale)
+        if p[_VARIES] != 0.0:
+            _set_density_scale(data, k, data[_BASE, k] * modulation[k])
         nu = max(data[_NU, k] - p[_REVOLUTIONS] * data[_NU_PER_REV, k], 0.0)
         nu_after[k] = nu
         x[k] = nu * (1.0 / NU_REF)
@@ -349,24 +349,12 @@ def compiled() -> _Kernels | None:
     except ImportError:
         return None
     helpers = (_cell, _locate, _new_segment, _heights_on_segment, _perigee_speed_m_s, _apogee_after_m, _sine)
-    for helper in (*helpers, _update_density, _burn):
+    for helper in (*helpers, _set_density_scale, _update_density, _burn):
         # Callable from the compiled loops, unchanged from Python. Not inlined by numba (that took the
         # first compilation from 4.7 s to 25 s); LLVM inlines the small ones, so the loops stay SIMD.
         numba.extending.register_jitable(helper)
     loops = (_burn_rows, _modulation_exponents, _coast_start, _coast_cells, _coast_finish)
     return _Kernels(*(numba.njit(cache=True, nogil=True)(loop) for loop in loops))
-
-
-@lru_cache(maxsize=8)
-def _parameters(density: Any) -> FloatArray:
-    """The density's numbers a burn reads, in the order of the ``_NOMINAL_S_DAY ... _PERIOD_DAYS`` indices."""
-    values = [
-        density.nominal_scale * SECONDS_PER_DAY,
-        density.varies,
-        density.cycle_amplitude,
-        density.cycle_period_days,
-    ]
-    return np.array(values, dtype=np.float64)
 
 
 @lru_cache(maxsize=8)
@@ -380,8 +368,8 @@ def burn_rows(
     state_data: FloatArray,
     rows: NDArray[np.intp],
     requested_dv_m_s: Any,
+    parameters: FloatArray,
     curves: UniversalCurves,
-    density: Any,
 ) -> FloatArray | None:
     """The burns of ``rows`` of a batch's state array, in place, compiled; None if not compiled here.
 
@@ -389,8 +377,8 @@ def burn_rows(
         state_data: A `~orbit_env.envs.task.BatchState`'s array (fields + cell rows, n).
         rows: The satellites asked to burn and able to (``min(request, dv left) > 0``).
         requested_dv_m_s: The burns asked for [m/s], a number or an array of shape (n,).
+        parameters: `orbit_env.envs.task.kernel_parameters` of the task.
         curves: The curves the task steps on.
-        density: The task's `~orbit_env.envs.config.DensityConfig`.
 
     Returns:
         The burns made [m/s], shape (n,) (0 off ``rows``), or None: numba missing,
@@ -407,7 +395,7 @@ def burn_rows(
     if requested.shape != (n,):
         requested = np.full(n, float(requested))
     made = np.zeros(n)
-    kernels.burn_rows(state_data, rows, requested, _parameters(density), *_tables(curves), made)
+    kernels.burn_rows(state_data, rows, requested, parameters, *_tables(curves), made)
     return made
 
 
@@ -422,7 +410,7 @@ def coast_and_observe(
     Args:
         state_data: A `~orbit_env.envs.task.BatchState`'s array, updated in place.
         made_m_s: The burns made in this step [m/s], shape (n,).
-        parameters: `coast_parameters` of the task.
+        parameters: `orbit_env.envs.task.kernel_parameters` of the task.
         curves: The curves the task steps on.
 
     Returns:
@@ -433,7 +421,7 @@ def coast_and_observe(
     n = state_data.shape[1]
     _, _, b_cells, b_grid = _tables(curves)
     first, second = np.empty(n), np.empty(n)
-    if parameters[_C_VARIES] != 0.0:
+    if parameters[_VARIES] != 0.0:
         kernels.modulation_exponents(state_data[_TIME], state_data[_PHASE], parameters, first)
         np.exp(first, out=first)
     nu_after = np.empty(n)

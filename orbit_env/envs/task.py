@@ -743,7 +743,9 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
             place(task, state, state.perigee_m, apogee_m)
         return dv
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s) > 0.0)  # asked to burn, and able to
-    compiled = kernel.burn_rows(state.data, asked, requested_dv_m_s, task.curves, task.density) if asked.size else None
+    compiled = None
+    if asked.size:
+        compiled = kernel.burn_rows(state.data, asked, requested_dv_m_s, kernel_parameters(task), task.curves)
     if compiled is not None:
         return compiled  # the same burns, one compiled loop (orbit_env.envs.kernel)
     made = np.zeros(state.size)
@@ -834,11 +836,12 @@ def step(task: Task, state: AnyState, requested_dv_m_s: Any) -> StepResult:
 
 
 @lru_cache(maxsize=16)
-def coast_parameters(task: Task) -> FloatArray:
-    """The numbers of a task that `orbit_env.envs.kernel.coast_and_observe` reads, in its order."""
+def kernel_parameters(task: Task) -> FloatArray:
+    """The numbers of a task that the compiled loops (`orbit_env.envs.kernel`) read, in their order."""
     config, density = task.config, task.density
-    values = [config.revolutions_per_step, config.propellant_cost_per_m_s, config.horizon_steps, density.varies]
-    values += [density.cycle_amplitude, density.cycle_period_days, 1.0 / HEIGHT_SCALE_M, 1.0 / DV_SCALE_M_S]
+    values = [config.revolutions_per_step, config.propellant_cost_per_m_s, config.horizon_steps]
+    values += [density.nominal_scale * SECONDS_PER_DAY, density.varies, density.cycle_amplitude]
+    values += [density.cycle_period_days, 1.0 / HEIGHT_SCALE_M, 1.0 / DV_SCALE_M_S]
     values += [LIFETIME_SCALE_DAYS, APOGEE_DROP_SCALE_M, PERIGEE_DROP_SCALE_M]
     return np.array(values, dtype=np.float64)
 
@@ -856,7 +859,7 @@ def step_and_observe(
         result = step(task, state, requested_dv_m_s)
         return result, observe(task, state)
     dv = burn(task, state, requested_dv_m_s)
-    reward, terminated, truncated, obs = kernel.coast_and_observe(state.data, dv, coast_parameters(task), task.curves)
+    reward, terminated, truncated, obs = kernel.coast_and_observe(state.data, dv, kernel_parameters(task), task.curves)
     return StepResult(reward, terminated, truncated, dv), obs
 
 
