@@ -36,8 +36,11 @@ is Int dW / (g c s) along the family's curve. On 10^4 rows over 0-98 deg this st
 within the 0.5% the curves hold of a family per 1-degree group, at the cost measured
 by ``benchmarks/bench_catalogue.py`` (docs/validation-modern.md section 7). A disposal
 rule searches its lowered perigees on the same family (`check_disposal_rule` with these
-lifetimes); the time-stepped path keeps a family per group. The paper's and the
-exponential law in still air do not depend on the inclination: one group.
+lifetimes). A dated catalogue (the time-stepped path) spread over more groups also takes
+one family, that of the most common group, through its chunks, each row's inclination a
+density multiplier in every chunk (`orbit_env.decay.chunked.propagate`), and the rule's
+search on those lifetimes. The paper's and the exponential law in still air do not
+depend on the inclination: one group.
 """
 
 from __future__ import annotations
@@ -66,11 +69,19 @@ from orbit_env.analysis.lifetime import (
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
-from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, G0_M_S2, MU_EARTH_M3_S2, SECONDS_PER_DAY
+from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import cell_value, read_csv
-from orbit_env.decay.chunked import orbit_ratio
+from orbit_env.decay.chunked import (
+    SPREAD_MAX_SPAN_M,
+    SPREAD_QUADRATURE_POINTS,
+    corotation_factor,
+    inclination_anchors,
+    inclination_basis,
+    interpolate_rows_with_slope,
+    life_rate_ratio,
+    orbit_ratio,
+)
 from orbit_env.decay.curves import NU_REF, UniversalCurves
-from orbit_env.physics.orbit import elements_from_heights
 
 FloatArray = NDArray[np.float64]
 
@@ -78,23 +89,15 @@ FloatArray = NDArray[np.float64]
 INCLINATION_STEP_DEG = 1.0
 #: A catalogue with more inclination groups than this takes one curve family and a density ratio.
 MAX_FAMILIES = 2
-#: Widest orbit [m] (apogee - perigee height) that takes the density ratio over the orbit; wider ones the
-#: ratio of the life's rates (one multiplier moves the perigee and the eccentricity alike: validation-modern.md, 7).
-SPREAD_MAX_SPAN_M = 100e3
-#: Inclinations [deg] at which a spread catalogue's NRLMSIS ratio is computed (interpolated between).
-ANCHOR_STEP_DEG = 10.0
 #: Heights [m] of the ratio (uniform: the rows' tables are read by index).
 RATIO_HEIGHTS_M = np.arange(100e3, 1200e3 + 1.0, 25e3)
 #: NRLMSIS nodes of the ratio; numerator and denominator alike, so the coarser sampling cancels.
 RATIO_NODES = {"latitude_nodes": 12, "local_time_nodes": 6}
 #: Points along each decay (equal steps of the curves' tau) where the multiplier is taken.
 PATH_NODES = 48
-#: Points along each decay of a wide row (on the rows of WIDE_QUADRATURE_POINTS in co-rotating air:
+#: Points along each decay of a wide row (on the rows of SPREAD_QUADRATURE_POINTS in co-rotating air:
 #: 24 leave up to 0.59%, 32 0.45%).
 WIDE_PATH_NODES = 32
-#: Anomalies of the wide rows' averaged rates (a ratio of two averages on the same nodes; on 10^4 rows
-#: 100-1500 km wide, 8 leave up to 0.96% against a family per inclination at 200 km perigees, 12 and 16 0.43%).
-WIDE_QUADRATURE_POINTS = 12
 #: Satellites per progress-bar step on the fixed-profile path.
 BLOCK = 20_000
 _ID_COLUMNS = ("name", "id")
@@ -217,6 +220,12 @@ def _spread_batch(
     return reference
 
 
+def _most_common(groups: FloatArray) -> float:
+    """The inclination group with the most rows (the one family's)."""
+    values, counts = np.unique(groups, return_counts=True)
+    return float(values[np.argmax(counts)])
+
+
 def _spread_lifetimes(
     scenario: Scenario,
     members: NDArray[np.intp],
@@ -231,8 +240,7 @@ def _spread_lifetimes(
     counts as not re-entered (as the time-stepped path's cap).
     """
     _, _, drag_parameter_m2_kg, inclination_deg = inputs
-    values, counts = np.unique(group_of[members], return_counts=True)
-    reference = float(values[np.argmax(counts)])
+    reference = _most_common(group_of[members])
     curves = scenario.curves(reference)
     log_ratio = inclination_log_ratio(scenario, reference, inclination_deg[members])
 
@@ -299,6 +307,39 @@ def _spread_rule(
     return check_disposal_rule(hp, ha, rule_years, lifetimes)
 
 
+def _stepped_spread(
+    scenario: Scenario,
+    members: NDArray[np.intp],
+    group_of: FloatArray,
+    inputs: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    rule_years: float | None,
+    cap_days: float | None,
+    outputs: tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_], FloatArray, FloatArray],
+) -> float:
+    """Lifetimes (and the rule) of ``members`` on the time-stepped path, one family; returns its inclination.
+
+    The family is that of the most common inclination group; every row keeps its own
+    inclination as a density multiplier (`orbit_env.decay.chunked.propagate`).
+    """
+    perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg = inputs
+    days, reentered, complies, new_hp, dv = outputs
+    reference = _most_common(group_of[members])
+    c, own = drag_parameter_m2_kg[members], inclination_deg[members]
+    if rule_years is None:
+        days[members], reentered[members] = scenario.lifetime_days(
+            perigee_m[members], apogee_m[members], c, reference, own_inclination_deg=own
+        )
+        return reference
+
+    def lifetimes(hp: FloatArray, ha: FloatArray, which: NDArray[np.intp]) -> Any:
+        return scenario.lifetime_days(hp, ha, c[which], reference, max_days=cap_days, own_inclination_deg=own[which])
+
+    check = check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes)
+    days[members], reentered[members] = check.lifetime_days, check.reentered
+    complies[members], new_hp[members], dv[members] = check.complies, check.new_perigee_m, check.dv_m_s
+    return reference
+
+
 def batch_lifetimes(
     rows: Sequence[dict[str, str]],
     perigee_m: FloatArray,
@@ -331,14 +372,18 @@ def batch_lifetimes(
         group_of = np.zeros(n)
     groups = np.unique(group_of[ok])
     cap_days = None if rule_years is None else (rule_years + 1.0) * 365.25
-    one_family = (
-        depends_on_inclination and not scenario.time_varying and not exact_groups and groups.size > MAX_FAMILIES
-    )
+    one_family = depends_on_inclination and not exact_groups and groups.size > MAX_FAMILIES
     by_groups = ok.copy()
     families: set[float] = set()
+    inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
+    outputs = (days, reentered, complies, new_hp, dv)
     with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
-        if one_family:
-            inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
+        if one_family and scenario.time_varying:
+            members = np.flatnonzero(ok)
+            families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs))
+            bar.update(members.size)
+            by_groups[:] = False
+        elif one_family:
             members = np.flatnonzero(ok)
             if rule_years is None:
                 families.add(_spread_batch(scenario, members, group_of, inputs, days, reentered, bar))
@@ -415,14 +460,10 @@ def inclination_log_ratio(scenario: Scenario, reference_deg: float, inclination_
     zero = np.zeros((inclination.size, RATIO_HEIGHTS_M.size))
     if scenario.atmosphere != "msis":
         return zero
-    from scipy.interpolate import make_interp_spline  # on use: half a second of start-up
-
     from orbit_env.decay.solar import ConstantActivity
     from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
 
-    low = np.floor(min(float(inclination.min()), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
-    high = np.ceil(max(float(inclination.max()), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
-    anchors = np.arange(low, high + 0.5 * ANCHOR_STEP_DEG, ANCHOR_STEP_DEG)
+    anchors = inclination_anchors(inclination, reference_deg)
     if anchors.size < 2:
         return zero
     solar = scenario.solar
@@ -436,8 +477,7 @@ def inclination_log_ratio(scenario: Scenario, reference_deg: float, inclination_
         scenario.ascending_node_local_time_h,
         **RATIO_NODES,
     )
-    spline = make_interp_spline(anchors, np.log(rho), k=min(3, anchors.size - 1), axis=0)
-    return np.asarray(spline(inclination) - spline(reference_deg)[None, :], dtype=np.float64)
+    return np.asarray(inclination_basis(anchors, inclination, reference_deg) @ np.log(rho), dtype=np.float64)
 
 
 def spread_lifetime_days(
@@ -505,13 +545,8 @@ def _spread_days(
     if wide:
         ratio = _life_rate_ratio(curves, log_ratio, inclination_deg, hp, ha, weighted)
     else:
-        dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
-        x = np.clip((hp - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
-        cell = x.astype(np.intp)
-        frac = x - cell
-        rows = np.arange(hp.shape[0])[:, None]
-        low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
-        ratio = np.exp(low + frac * (high - low))
+        log_value, log_slope = interpolate_rows_with_slope(log_ratio, RATIO_HEIGHTS_M, hp)
+        ratio = np.exp(log_value)
         if scenario.atmosphere == "msis":
             from orbit_env.decay.chunked import log_density_slope_per_m
             from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
@@ -519,14 +554,9 @@ def _spread_days(
             atmosphere = curves.model.atmosphere
             assert isinstance(atmosphere, MsisAtmosphere)
             density_slope = np.interp(hp, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
-            ratio = orbit_ratio(ratio, (high - low) / dh, density_slope, hp, ha)
+            ratio = orbit_ratio(ratio, log_slope, density_slope, hp, ha)
     if scenario.rotating_atmosphere and not wide:  # the wide rows' rates carry their air's speed
-        p, e = elements_from_heights(hp, ha)
-        r_p = EARTH_RADIUS_M + hp
-        v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
-        wind = EARTH_ROTATION_RAD_S * r_p
-        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))[:, None]
-        ratio = ratio * ((v_p - wind * cos_i) / (v_p - wind * np.cos(np.radians(reference_deg)))) ** 2
+        ratio = ratio * corotation_factor(hp, ha, np.asarray(inclination_deg, dtype=np.float64)[:, None], reference_deg)
     inverse = 1.0 / ratio
     time_gcs = np.sum(np.diff(weighted, axis=1) * 0.5 * (inverse[:, 1:] + inverse[:, :-1]), axis=1)
     return np.asarray(time_gcs / (G0_M_S2 * drag_parameter_m2_kg * scenario.density_scale) / SECONDS_PER_DAY)
@@ -542,61 +572,25 @@ def _life_rate_ratio(
 ) -> FloatArray:
     """dW/dnu of each row's air over the reference's, at orbits (rows, nodes) on the reference curves.
 
-    W is the life left on the reference curves (times g c), ``weighted`` at these orbits.
-    The orbit stays on the reference curve, so what must be right is how fast W falls:
-    W_p p' + W_e e' with the averaged equations' rates p', e' (`WIDE_QUADRATURE_POINTS`
-    anomalies) under the row's profile (in co-rotating air, at the row's inclination),
-    over the same under the reference's. One multiplier of the density at the perigee
-    (`orbit_ratio`) moves p and e alike, where a profile of another shape moves the
-    eccentricity otherwise: on orbits up to 1500 km wide it came out up to 2.3% off a
-    family per inclination, this within 0.46% (docs/validation-modern.md, section 7).
-    The gradient of W by forward differences (the steps of `orbit_env.decay.chunked`),
-    towards higher perigees; at re-entry (the first node) the next node's ratio.
+    `orbit_env.decay.chunked.life_rate_ratio` with `SPREAD_QUADRATURE_POINTS` anomalies,
+    in co-rotating air at the row's inclination. One multiplier of the density at the
+    perigee (`orbit_ratio`) moves p and e alike, where a profile of another shape moves
+    the eccentricity otherwise: on orbits up to 1500 km wide it came out up to 2.3% off
+    a family per inclination, this within 0.46% (docs/validation-modern.md, section 7).
+    At re-entry (the first node) the next node's ratio.
     """
-    from orbit_env.decay.averaged import DecayModel
-    from orbit_env.decay.chunked import GRADIENT_STEP_E, GRADIENT_STEP_P_M, SolarDecayModel
-    from orbit_env.physics.atmosphere import FunctionAtmosphere
-
-    model = curves.model
-    reference = model.atmosphere
-    dh = float(RATIO_HEIGHTS_M[1] - RATIO_HEIGHTS_M[0])
-    rows = np.arange(perigee_m.shape[0])[:, None, None]
-
-    last: list[FloatArray] = []
-
-    def row_density(h: FloatArray) -> FloatArray:
-        # h is (rows, nodes, anomalies): each row reads its own log-ratio table. In co-rotating air the
-        # three calls below ask for the same heights: the density is computed once.
-        if last and np.array_equal(last[0], h):
-            return last[1]
-        x = np.clip((h - RATIO_HEIGHTS_M[0]) / dh, 0.0, RATIO_HEIGHTS_M.size - 1.000001)
-        cell = x.astype(np.intp)
-        low, high = log_ratio[rows, cell], log_ratio[rows, cell + 1]
-        rho = np.asarray(reference.density_kg_m3(h) * np.exp(low + (x - cell) * (high - low)), dtype=np.float64)
-        last[:] = [h, rho]
-        return rho
-
-    p, e = elements_from_heights(perigee_m, apogee_m)
-    e = np.maximum(e, 0.0)
-    if model.rotating_atmosphere:
-        # The air's speed (Omega r cos i) enters the rates nonlinearly but smoothly (Omega r / v < 0.07):
-        # rates at cos i = 0 and 1, and each row's cos i on the line through them.
-        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))[:, None]
-        weights, nodes_deg = (1.0 - cos_i, cos_i), (90.0, 0.0)
-    else:
-        weights, nodes_deg = (np.ones((perigee_m.shape[0], 1)),), (model.inclination_deg,)
-    dp_row, de_row = np.zeros(perigee_m.shape), np.zeros(perigee_m.shape)
-    air = FunctionAtmosphere(row_density)
-    for weight, node in zip(weights, nodes_deg, strict=True):
-        node_dp, node_de = DecayModel(air, model.rotating_atmosphere, node, WIDE_QUADRATURE_POINTS).rates_per_nu(p, e)
-        dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
-    own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, WIDE_QUADRATURE_POINTS)
-    dp_ref, de_ref = own.rates_per_nu(p, e)
-    w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - weighted) / GRADIENT_STEP_P_M
-    w_e = (weighted - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
-    ratio = (w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref)
+    ratio = life_rate_ratio(
+        curves,
+        log_ratio,
+        RATIO_HEIGHTS_M,
+        perigee_m,
+        apogee_m,
+        quadrature_points=SPREAD_QUADRATURE_POINTS,
+        inclination_deg=inclination_deg,
+        weighted=weighted,
+    )
     ratio[:, 0] = ratio[:, 1]
-    return np.asarray(ratio, dtype=np.float64)
+    return ratio
 
 
 def _fmt(value: float) -> str:

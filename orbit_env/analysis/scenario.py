@@ -204,14 +204,19 @@ class Scenario:
         *,
         density_scale: ArrayLike = 1.0,
         max_days: float | None = None,
+        own_inclination_deg: ArrayLike | None = None,
     ) -> tuple[FloatArray, NDArray[np.bool_]]:
         """Days to re-entry of many satellites (one inclination), and whether they re-enter.
 
         Fixed profiles: one lookup on the universal curves. Time-varying: the
-        chunked curves, stopped after ``max_days`` if given (else ``max_years``).
+        chunked curves, stopped after ``max_days`` if given (else ``max_years``);
+        with ``own_inclination_deg``, each satellite's inclination on the curves of
+        ``inclination_deg`` (`orbit_env.decay.chunked.propagate`).
 
         Raises:
-            ValueError: heights invalid or outside the universal curves' domain.
+            ValueError: heights invalid or outside the universal curves' domain, or
+                ``own_inclination_deg`` on a fixed profile (the catalogue's one-family
+                path serves those).
         """
         hp, ha = UniversalCurves.check_domain(perigee_m, apogee_m)
         hp, ha, c, s = np.broadcast_arrays(
@@ -219,6 +224,8 @@ class Scenario:
         )
         s = s * self.density_scale
         if not self.time_varying:
+            if own_inclination_deg is not None:
+                raise ValueError("own_inclination_deg applies to the time-stepped path only")
             point = self.curves(inclination_deg).locate(hp, ha)
             days = np.asarray(point.weighted_s / (G0_M_S2 * c * s) / SECONDS_PER_DAY, dtype=np.float64)
             return days, np.ones(days.shape, dtype=bool)
@@ -234,5 +241,6 @@ class Scenario:
                 chunk_days=model.chunk_days,
                 max_years=max(max_days / 365.25, model.chunk_days / 365.25),
             )
-        result = propagate(hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel())
+        own = None if own_inclination_deg is None else np.broadcast_to(own_inclination_deg, hp.shape).ravel()
+        result = propagate(hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel(), inclination_deg=own)
         return result.days.reshape(hp.shape), result.reentered.reshape(hp.shape)

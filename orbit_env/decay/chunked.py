@@ -69,7 +69,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_number
-from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import (
+    EARTH_RADIUS_M,
+    EARTH_ROTATION_RAD_S,
+    G0_M_S2,
+    MU_EARTH_M3_S2,
+    REENTRY_ALTITUDE_M,
+    SECONDS_PER_DAY,
+)
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import SolarActivity, day_of_year
@@ -113,6 +120,18 @@ AVERAGED_MIN_X = 0.5
 RATIO_QUADRATURE_POINTS = 8
 #: Ap values of the bins (nearest in log).
 AP_BINS = (3.0, 6.0, 12.0, 24.0, 48.0, 96.0, 192.0, 384.0)
+#: Widest orbit [m] (apogee - perigee height) of another inclination than the family's that takes the density ratio
+#: over the orbit; wider ones the ratio of the life's rates (one multiplier moves the perigee and the eccentricity
+#: alike: docs/validation-modern.md, section 7).
+SPREAD_MAX_SPAN_M = 100e3
+#: Anomalies of those wider orbits' rates (a ratio of two averages on the same nodes; on 10^4 rows 100-1500 km wide,
+#: 8 leave up to 0.96% against a family per inclination at 200 km perigees, 12 and 16 0.43%).
+SPREAD_QUADRATURE_POINTS = 12
+#: Those wider orbits' ratio of the life's rates is recomputed when the perigee has moved this far [m] (or the bin
+#: changed), and held in between as a factor on the ratio over the orbit.
+SPREAD_REFRESH_M = 5e3
+#: Inclinations [deg] at which the NRLMSIS density of other inclinations is computed (a spline between).
+ANCHOR_STEP_DEG = 10.0
 #: Heights at which the exact/bin density ratio is tabulated [m].
 RATIO_GRID_M = np.arange(100e3, 1200e3 + 1.0, 50e3)
 #: Latitude and local-time nodes of the ratio (both profiles sampled alike).
@@ -215,6 +234,105 @@ def orbit_ratio(
         return np.exp(ax - x) * (i0e(ax) + 2.0 * e * np.sign(x) * i1e(ax))
 
     return np.asarray(ratio_at_perigee, dtype=np.float64) * weight(x1) / weight(x0)
+
+
+def interpolate_rows(table: FloatArray, grid_m: FloatArray, height_m: FloatArray) -> FloatArray:
+    """Row k of ``height_m`` (any trailing shape) interpolated linearly in row k of ``table`` (rows, heights).
+
+    ``grid_m`` is uniform (the rows' tables are read by index); heights beyond it take
+    its end values, as ``np.interp``. A table of one row serves every row of ``height_m``.
+    """
+    return interpolate_rows_with_slope(table, grid_m, height_m)[0]
+
+
+def interpolate_rows_with_slope(
+    table: FloatArray, grid_m: FloatArray, height_m: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """`interpolate_rows`, and the slope of the table's cell each height falls in [1/m]."""
+    h = np.asarray(height_m, dtype=np.float64)
+    dh = float(grid_m[1] - grid_m[0])
+    x = np.clip((h - grid_m[0]) / dh, 0.0, grid_m.size - 1.000001)
+    cell = x.astype(np.intp)
+    rows = 0 if table.shape[0] == 1 else np.arange(table.shape[0]).reshape(-1, *([1] * (h.ndim - 1)))
+    low, high = table[rows, cell], table[rows, cell + 1]
+    return np.asarray(low + (x - cell) * (high - low), dtype=np.float64), np.asarray((high - low) / dh)
+
+
+def corotation_factor(
+    perigee_m: FloatArray, apogee_m: FloatArray, inclination_deg: ArrayLike, reference_deg: float
+) -> FloatArray:
+    """Drag in co-rotating air at each orbit's inclination over that at ``reference_deg``, at the perigee.
+
+    ((v_p - Omega r_p cos i) / (v_p - Omega r_p cos i_ref))^2: the air's speed along
+    the orbit at the perigee, where near-circular orbits meet most of their drag.
+    ``inclination_deg`` broadcasts against the heights.
+    """
+    p, e = elements_from_heights(perigee_m, apogee_m)
+    v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
+    wind = EARTH_ROTATION_RAD_S * (EARTH_RADIUS_M + perigee_m)
+    cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
+    return np.asarray(((v_p - wind * cos_i) / (v_p - wind * math.cos(math.radians(reference_deg)))) ** 2)
+
+
+def life_rate_ratio(
+    curves: UniversalCurves,
+    log_ratio: FloatArray,
+    grid_m: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    *,
+    quadrature_points: int,
+    inclination_deg: FloatArray | None = None,
+    weighted: FloatArray | None = None,
+) -> FloatArray:
+    """dW/dnu under each row's air over the same under the air of ``curves``, at orbits on those curves.
+
+    W is the life left on ``curves`` (times g c; ``weighted``, if known, its value at the
+    orbits). Row k's air is the curves' density times exp(``log_ratio[k]``) (on the uniform
+    ``grid_m``; a table of one row serves all). The orbit stays on the curves, so what
+    must be right is how fast W falls: W_p p' + W_e e' with the averaged equations'
+    rates p', e' (``quadrature_points`` anomalies) under the row's air over the same
+    under the curves' own; one density multiplier at the perigee (`orbit_ratio`) would
+    move p and e alike, where a profile of another shape moves the eccentricity
+    otherwise. The gradient of W by forward differences (`GRADIENT_STEP_P_M`,
+    `GRADIENT_STEP_E`), towards higher perigees. In co-rotating air with
+    ``inclination_deg`` (one per row), the air's speed (Omega r cos i) enters the rates
+    nonlinearly but smoothly (Omega r / v < 0.07): rates at cos i = 0 and 1, and each
+    row's cos i on the line through them; without, the curves' inclination. Heights
+    have shape (rows, ...).
+    """
+    model = curves.model
+    reference = model.atmosphere
+    last: list[FloatArray] = []
+
+    def row_density(h: FloatArray) -> FloatArray:
+        # h is (rows, ..., anomalies): each row reads its own table. In co-rotating air the calls ask
+        # for the same heights: the density is computed once.
+        if last and np.array_equal(last[0], h):
+            return last[1]
+        rho = np.asarray(reference.density_kg_m3(h) * np.exp(interpolate_rows(log_ratio, grid_m, h)), dtype=np.float64)
+        last[:] = [h, rho]
+        return rho
+
+    p, e = elements_from_heights(perigee_m, apogee_m)
+    e = np.maximum(e, 0.0)
+    extra = (1,) * (np.ndim(perigee_m) - 1)
+    if model.rotating_atmosphere and inclination_deg is not None:
+        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64))).reshape(-1, *extra)
+        weights, nodes_deg = (1.0 - cos_i, cos_i), (90.0, 0.0)
+    else:
+        weights, nodes_deg = (np.ones((1, *extra)),), (model.inclination_deg,)
+    dp_row, de_row = np.zeros(np.shape(p)), np.zeros(np.shape(p))
+    air = FunctionAtmosphere(row_density)
+    for weight, node in zip(weights, nodes_deg, strict=True):
+        node_dp, node_de = DecayModel(air, model.rotating_atmosphere, node, quadrature_points).rates_per_nu(p, e)
+        dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
+    own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
+    dp_ref, de_ref = own.rates_per_nu(p, e)
+    w0 = SolarDecayModel.weight_of(curves, p, e) if weighted is None else weighted
+    w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
+    w_e = (w0 - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
+    return np.asarray((w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref), dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -321,47 +439,119 @@ class SolarDecayModel:
         *,
         averaged: bool = False,
         log_ratio: FloatArray | None = None,
+        offsets: FloatArray | None = None,
+        inclination_deg: FloatArray | None = None,
     ) -> FloatArray:
         """The chunk's mean density over the bin's, over each orbit (the multiplier s).
 
         King-Hele's local form (`orbit_ratio`); with ``averaged``, for orbits wider than
         `AVERAGED_MIN_X`, the ratio of dW/dnu (W the life left on the bin's curves) under
-        the chunk's profile (the bin's times the tabulated ratio) and under the bin's,
-        from the averaged equations' dp/dnu and de/dnu with `RATIO_QUADRATURE_POINTS`
-        anomalies (the module docstring, step 3). ``log_ratio`` (on `RATIO_GRID_M`) replaces
-        the one of ``daily`` (`log_ratio`).
+        the chunk's profile (the bin's times the tabulated ratio) and under the bin's
+        (`life_rate_ratio` with `RATIO_QUADRATURE_POINTS` anomalies; the module docstring,
+        step 3). ``log_ratio`` (on `RATIO_GRID_M`) replaces the one of ``daily``
+        (`log_ratio`). ``offsets`` (satellites, `RATIO_GRID_M`) adds each satellite's
+        ln(density at its inclination ``inclination_deg`` / at the model's), see
+        `propagate`; in co-rotating air such a satellite's ratio carries its air's speed
+        (`corotation_factor`, or the rates at its inclination).
         """
         if log_ratio is None:
             log_ratio = self.log_ratio(daily, binned)
-        at_perigee = np.exp(np.interp(perigee_m, RATIO_GRID_M, log_ratio))
-        ratio_slope = np.interp(perigee_m, RATIO_GRID_M, np.gradient(log_ratio, RATIO_GRID_M))
+        if offsets is not None and inclination_deg is not None:
+            spread = np.any(offsets != 0.0, axis=1)
+            if not spread.all():  # the model's own inclination exactly as without offsets
+                ratio = np.empty(np.shape(perigee_m))
+                for rows, extra in ((~spread, (None, None)), (spread, (offsets[spread], inclination_deg[spread]))):
+                    if rows.any():
+                        ratio[rows] = self.density_ratio(
+                            daily,
+                            binned,
+                            perigee_m[rows],
+                            apogee_m[rows],
+                            averaged=averaged,
+                            log_ratio=log_ratio,
+                            offsets=extra[0],
+                            inclination_deg=extra[1],
+                        )
+                return ratio
+        table = log_ratio[None, :] if offsets is None else log_ratio[None, :] + offsets
+        at_perigee = np.exp(interpolate_rows(table, RATIO_GRID_M, perigee_m))
+        ratio_slope = interpolate_rows(np.gradient(table, RATIO_GRID_M, axis=1), RATIO_GRID_M, perigee_m)
         atmosphere = self.bin_model(binned).atmosphere
         assert isinstance(atmosphere, MsisAtmosphere)
         density_slope = np.interp(perigee_m, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
         ratio = orbit_ratio(at_perigee, ratio_slope, density_slope, perigee_m, apogee_m)
+        if self.rotating_atmosphere and inclination_deg is not None:
+            ratio = ratio * corotation_factor(perigee_m, apogee_m, inclination_deg, self.inclination_deg)
         if not averaged:
             return ratio
         wide = np.flatnonzero(0.5 * (apogee_m - perigee_m) * -density_slope > AVERAGED_MIN_X)
         if wide.size:
-            chunk = FunctionAtmosphere(
-                lambda h: atmosphere.density_kg_m3(h) * np.exp(np.interp(h, RATIO_GRID_M, log_ratio))
-            )
-            p, e = elements_from_heights(perigee_m[wide], apogee_m[wide])
-            (dp_chunk, de_chunk), (dp_bin, de_bin) = (
-                DecayModel(air, self.rotating_atmosphere, self.inclination_deg, RATIO_QUADRATURE_POINTS).rates_per_nu(
-                    p, e
-                )
-                for air in (chunk, atmosphere)
-            )
             # dW/dt along the bin's curve is g c s: s weights the two rates by the gradient of W (the
             # remaining life on the bin's curves) in (p, e), so that the life left falls at the chunk's rate
-            # although the orbit stays on the bin's curve (forward differences, towards higher perigees).
-            curves = cached_curves(self.bin_model(binned))
-            w0 = self.weight_of(curves, p, e)
-            w_p = (self.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
-            w_e = (w0 - self.weight_of(curves, p, e - GRADIENT_STEP_E)) / GRADIENT_STEP_E
-            ratio[wide] = (w_p * dp_chunk + w_e * de_chunk) / (w_p * dp_bin + w_e * de_bin)
+            # although the orbit stays on the bin's curve.
+            ratio[wide] = life_rate_ratio(
+                cached_curves(self.bin_model(binned)),
+                table if offsets is None else table[wide],
+                RATIO_GRID_M,
+                perigee_m[wide],
+                apogee_m[wide],
+                quadrature_points=RATIO_QUADRATURE_POINTS if offsets is None else SPREAD_QUADRATURE_POINTS,
+                inclination_deg=None if inclination_deg is None else inclination_deg[wide],
+            )
         return ratio
+
+    def inclination_offsets(self, t_days: float, basis: FloatArray, anchors_deg: FloatArray) -> FloatArray:
+        """ln(density at each satellite's inclination / at the model's) on `RATIO_GRID_M` in the chunk from ``t_days``.
+
+        NRLMSIS at the chunk's mean indices (F10.7, its 81-day mean, Ap) and its middle
+        day of the year, orbit-averaged at the inclinations ``anchors_deg`` in one call
+        (cached), combined by ``basis`` (satellites, anchors: `inclination_basis`).
+        """
+        samples = max(1, math.ceil(self.chunk_days))
+        days = self.start_days + t_days + np.arange(samples) * (self.chunk_days / samples)
+        f107, f107a, ap = (round(float(np.mean(x)), 1) for x in self.activity.indices(days))
+        middle = self.start_days + t_days + 0.5 * self.chunk_days
+        doy = float(np.clip(2.0 * np.round(day_of_year(middle) / 2.0), 1.0, 366.0)) if self.follow_season else None
+        log_rho = _anchor_log_density(
+            (f107, f107a, ap, doy), tuple(anchors_deg.tolist()), self.ascending_node_local_time_h
+        )
+        return np.asarray(basis @ log_rho, dtype=np.float64)
+
+
+@lru_cache(maxsize=4096)
+def _anchor_log_density(
+    indices: tuple[float, float, float, float | None],
+    anchors_deg: tuple[float, ...],
+    ascending_node_local_time_h: float | None,
+) -> FloatArray:
+    from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
+
+    f107, f107a, ap, doy = indices
+    rho = mean_density_over_inclinations_kg_m3(
+        RATIO_GRID_M, f107, f107a, ap, anchors_deg, ascending_node_local_time_h, day_of_year=doy, **RATIO_NODES
+    )
+    return np.log(rho)
+
+
+def inclination_anchors(inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
+    """Every `ANCHOR_STEP_DEG` spanning ``inclination_deg`` and ``reference_deg`` [deg] (one, if they all agree)."""
+    low = math.floor(min(float(np.min(inclination_deg)), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
+    high = math.ceil(max(float(np.max(inclination_deg)), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
+    return np.arange(low, high + 0.5 * ANCHOR_STEP_DEG, ANCHOR_STEP_DEG)
+
+
+def inclination_basis(anchors_deg: FloatArray, inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
+    """B (satellites, anchors): B @ f(anchors) is f(i) - f(reference) of the cubic spline through them.
+
+    The interpolating spline is linear in its data, so its basis, the splines of the
+    unit vectors, turns a table at the anchors into values at the inclinations in one
+    product. Zero rows at the reference.
+    """
+    from scipy.interpolate import make_interp_spline  # on use: half a second of start-up
+
+    spline = make_interp_spline(anchors_deg, np.eye(anchors_deg.size), k=min(3, anchors_deg.size - 1), axis=0)
+    at = np.asarray(spline(np.asarray(inclination_deg, dtype=np.float64)), dtype=np.float64)
+    return at - np.asarray(spline(reference_deg), dtype=np.float64)[None, :]
 
 
 @dataclass(frozen=True)
@@ -420,6 +610,8 @@ def _daily_steps(
     hp: FloatArray,
     ha: FloatArray,
     t0: float,
+    offsets: FloatArray | None = None,
+    inclination_deg: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, tuple[list[float], list[FloatArray], list[FloatArray]]]:
     """The chunk from ``t0`` a day (`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
 
@@ -428,7 +620,8 @@ def _daily_steps(
     does. A satellite with less than `LAST_DAYS` left at the day's rate goes through
     the day in `LAST_STEPS` steps. Returns the re-entry day (NaN for a satellite still
     up at the chunk's end), nu and the heights at the chunk's end (or at re-entry), and
-    the days' ends and heights (for the history).
+    the days' ends and heights (for the history). ``offsets`` and ``inclination_deg``:
+    the satellites' own inclinations (`SolarDecayModel.density_ratio`).
     """
     first_day = math.floor(t0)
     log_ratios = model.log_ratios_by_day(first_day, math.floor(t0 + model.chunk_days) + 2 - first_day, binned)
@@ -444,7 +637,16 @@ def _daily_steps(
         day = min(math.floor(middle), log_ratios.shape[0] - 2)
         weight = middle - day
         log_ratio = (1.0 - weight) * log_ratios[day] + weight * log_ratios[day + 1]
-        ratio = model.density_ratio((), binned, hp[which], ha[which], averaged=True, log_ratio=log_ratio)
+        ratio = model.density_ratio(
+            (),
+            binned,
+            hp[which],
+            ha[which],
+            averaged=True,
+            log_ratio=log_ratio,
+            offsets=None if offsets is None else offsets[which],
+            inclination_deg=None if inclination_deg is None else inclination_deg[which],
+        )
         _, _, w0 = _weight_at(curves, label[which], nu[which])
         return w0, gcs[which] * ratio
 
@@ -486,6 +688,68 @@ def _daily_steps(
     return days, nu, hp, ha, (times, heights_p, heights_a)
 
 
+@dataclass
+class _Spread:
+    """What `propagate` keeps for satellites of other inclinations than the model's (see there)."""
+
+    inclination_deg: FloatArray
+    anchors_deg: FloatArray
+    basis: FloatArray
+    wide: NDArray[np.bool_]
+    factor: FloatArray
+    factor_perigee_m: FloatArray
+
+    @classmethod
+    def of(
+        cls, model: SolarDecayModel, inclination_deg: ArrayLike | None, hp: FloatArray, ha: FloatArray
+    ) -> _Spread | None:
+        """None when every satellite has the model's inclination."""
+        if inclination_deg is None:
+            return None
+        inclination = np.broadcast_to(np.asarray(inclination_deg, dtype=np.float64), hp.shape).copy()
+        if np.all(inclination == model.inclination_deg):
+            return None
+        anchors = inclination_anchors(inclination, model.inclination_deg)
+        basis = inclination_basis(anchors, inclination, model.inclination_deg)
+        wide = np.any(basis != 0.0, axis=1) & (ha - hp > SPREAD_MAX_SPAN_M)
+        return cls(inclination, anchors, basis, wide, np.ones(hp.size), np.full(hp.size, np.nan))
+
+    def wide_factor(
+        self,
+        model: SolarDecayModel,
+        curves: UniversalCurves,
+        daily: DailyIndices,
+        binned: tuple[float, float],
+        active: NDArray[np.intp],
+        offsets: FloatArray,
+        hp: FloatArray,
+        ha: FloatArray,
+        ratio: FloatArray,
+        new_bin: bool,
+    ) -> FloatArray:
+        """The wide satellites' `life_rate_ratio` over their ``ratio`` (`orbit_ratio`'s), refreshed as needed.
+
+        1 for the others.
+        """
+        wide = self.wide[active]
+        stale = wide & (new_bin | ~(np.abs(hp[active] - self.factor_perigee_m[active]) <= SPREAD_REFRESH_M))
+        if stale.any():
+            rows = active[stale]
+            table = model.log_ratio(daily, binned)[None, :] + offsets[stale]
+            rate = life_rate_ratio(
+                curves,
+                table,
+                RATIO_GRID_M,
+                hp[rows],
+                ha[rows],
+                quadrature_points=SPREAD_QUADRATURE_POINTS,
+                inclination_deg=self.inclination_deg[rows],
+            )
+            self.factor[rows] = rate / ratio[stale]
+            self.factor_perigee_m[rows] = hp[rows]
+        return self.factor[active]
+
+
 def propagate(
     perigee_m: ArrayLike,
     apogee_m: ArrayLike,
@@ -495,8 +759,22 @@ def propagate(
     density_scale: ArrayLike = 1.0,
     record: bool = False,
     progress: Callable[[float], None] | None = None,
+    inclination_deg: ArrayLike | None = None,
 ) -> SolarLifetime:
     """Propagate satellites to re-entry under the activity of ``model`` (see the module docstring).
+
+    With ``inclination_deg`` (per satellite), satellites of other inclinations than the
+    model's stay on the model's curves and take their own inclination as a density
+    multiplier as well: in each chunk, NRLMSIS at the chunk's mean indices and middle
+    day of the year, every `ANCHOR_STEP_DEG` in one call, gives ln(density at the
+    satellite's inclination / at the model's) by a cubic spline in inclination
+    (`SolarDecayModel.inclination_offsets`), added to the chunk's ratio. Orbits up to
+    `SPREAD_MAX_SPAN_M` wide take it over the orbit (`orbit_ratio`), in co-rotating air
+    times `corotation_factor`; wider ones the ratio of the rates at which the life left
+    falls (`life_rate_ratio`), refreshed when the bin changes or the perigee has moved
+    `SPREAD_REFRESH_M` since, and held in between as a factor on `orbit_ratio`'s. A
+    catalogue spread over inclinations then costs one family, not one per inclination
+    (docs/validation-modern.md, section 7).
 
     Args:
         perigee_m: Initial perigee heights [m] (in the curves' domain: the caller checks).
@@ -506,6 +784,7 @@ def propagate(
         density_scale: Multiplier on the density (e.g. a fitted scale factor).
         record: Keep the heights at every chunk boundary.
         progress: Called with the fraction of satellites re-entered after each chunk.
+        inclination_deg: Each satellite's inclination (default: the model's).
     """
     hp, ha, c, scale = (
         np.array(x, dtype=np.float64).ravel()
@@ -518,6 +797,7 @@ def propagate(
     )
     n = hp.size
     gcs = G0_M_S2 * c * scale
+    spread = _Spread.of(model, inclination_deg, hp, ha)
     days = np.full(n, model.max_years * 365.25)
     reentered = hp <= REENTRY_ALTITUDE_M
     days[reentered] = 0.0
@@ -535,13 +815,23 @@ def propagate(
         t0 = k * model.chunk_days
         daily, binned = model.chunk_condition(t0)
         bins.add(binned)
-        if binned != key_prev:
+        new_bin = binned != key_prev
+        if new_bin:
             curves = cached_curves(model.bin_model(binned))
             point = curves.locate(hp[active], ha[active])
             label, tau = point.label, point.tau
             key_prev = binned
         assert curves is not None
-        s = model.density_ratio(daily, binned, hp[active], ha[active])
+        if spread is None:
+            offsets = inclination = None
+            s = model.density_ratio(daily, binned, hp[active], ha[active])
+        else:
+            offsets, inclination = (
+                model.inclination_offsets(t0, spread.basis[active], spread.anchors_deg),
+                spread.inclination_deg[active],
+            )
+            s = model.density_ratio(daily, binned, hp[active], ha[active], offsets=offsets, inclination_deg=inclination)
+            s = s * spread.wide_factor(model, curves, daily, binned, active, offsets, hp, ha, s, new_bin)
         rate = gcs[active] * s  # dW/dt: W falls by this per second
         nu0 = NU_REF * np.expm1(tau)
         _, _, w0 = _weight_at(curves, label, nu0)
@@ -564,6 +854,8 @@ def propagate(
                 hp_new[which],
                 ha_new[which],
                 t0,
+                None if offsets is None else offsets[which],
+                None if inclination is None else inclination[which],
             )
             ended = np.isfinite(f_days)
             days[active[which[ended]]] = f_days[ended]

@@ -255,11 +255,12 @@ def mean_density_over_inclinations_kg_m3(
     inclinations_deg: ArrayLike,
     ascending_node_local_time_h: float | None = None,
     *,
+    day_of_year: float | None = None,
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
     season_nodes: int = SEASON_NODES,
 ) -> FloatArray:
-    """`mean_density_kg_m3` (averaged over the year) at several inclinations, in one NRLMSIS call.
+    """`mean_density_kg_m3` (averaged over the year, or on ``day_of_year``) at several inclinations, in one call.
 
     Returns an array (inclinations, altitudes): row k is `mean_density_kg_m3` at
     ``inclinations_deg[k]`` with the same nodes. One call for all rows: NRLMSIS's
@@ -273,7 +274,10 @@ def mean_density_over_inclinations_kg_m3(
     ]
     lat = np.stack([s[0] for s in samples])  # (inclinations, samples)
     local_time = np.stack([s[1] for s in samples])
-    days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
+    if day_of_year is None:
+        days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
+    else:
+        days = np.array([float(day_of_year) - 1.0])
     return _msis_density(alt, lat, local_time, days, f107_sfu, f107a_sfu, ap).mean(axis=(1, 2))
 
 
