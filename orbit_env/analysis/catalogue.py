@@ -322,7 +322,7 @@ def _stepped_spread(
     inclination as a density multiplier (`orbit_env.decay.chunked.propagate`).
     """
     perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg = inputs
-    days, reentered, complies, new_hp, dv = outputs
+    days, reentered = outputs[:2]
     reference = _most_common(group_of[members])
     c, own = drag_parameter_m2_kg[members], inclination_deg[members]
     if rule_years is None:
@@ -334,10 +334,19 @@ def _stepped_spread(
     def lifetimes(hp: FloatArray, ha: FloatArray, which: NDArray[np.intp]) -> Any:
         return scenario.lifetime_days(hp, ha, c[which], reference, max_days=cap_days, own_inclination_deg=own[which])
 
-    check = check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes)
-    days[members], reentered[members] = check.lifetime_days, check.reentered
-    complies[members], new_hp[members], dv[members] = check.complies, check.new_perigee_m, check.dv_m_s
+    _store_check(outputs, members, check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes))
     return reference
+
+
+def _store_check(
+    outputs: tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_], FloatArray, FloatArray],
+    rows: NDArray[np.intp],
+    check: Any,
+) -> None:
+    """Write a rule check's lifetimes, verdicts, lowered perigees and burns into the batch's columns at ``rows``."""
+    days, reentered, complies, new_hp, dv = outputs
+    days[rows], reentered[rows] = check.lifetime_days, check.reentered
+    complies[rows], new_hp[rows], dv[rows] = check.complies, check.new_perigee_m, check.dv_m_s
 
 
 def batch_lifetimes(
@@ -378,21 +387,18 @@ def batch_lifetimes(
     inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
     outputs = (days, reentered, complies, new_hp, dv)
     with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
-        if one_family and scenario.time_varying:
+        if one_family:
             members = np.flatnonzero(ok)
-            families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs))
-            bar.update(members.size)
-            by_groups[:] = False
-        elif one_family:
-            members = np.flatnonzero(ok)
-            if rule_years is None:
+            if scenario.time_varying:
+                families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs))
+                bar.update(members.size)
+            elif rule_years is None:
                 families.add(_spread_batch(scenario, members, group_of, inputs, days, reentered, bar))
             else:  # the rule's search for the lowered perigee on the same family
                 reference, lifetimes = _spread_lifetimes(scenario, members, group_of, inputs)
                 families.add(reference)
                 check = _spread_rule(scenario, reference, inputs, members, lifetimes, rule_years, cap_days)
-                days[members], reentered[members] = check.lifetime_days, check.reentered
-                complies[members], new_hp[members], dv[members] = check.complies, check.new_perigee_m, check.dv_m_s
+                _store_check(outputs, members, check)
                 bar.update(members.size)
             by_groups[:] = False
         for group in np.unique(group_of[by_groups]):
@@ -412,9 +418,9 @@ def batch_lifetimes(
                     def lifetimes(hp: FloatArray, ha: FloatArray, which: NDArray[np.intp]) -> Any:
                         return scenario.lifetime_days(hp, ha, c_block[which], inclination, max_days=cap_days)  # noqa: B023
 
-                    check = check_disposal_rule(perigee_m[block], apogee_m[block], rule_years, lifetimes)
-                    days[block], reentered[block] = check.lifetime_days, check.reentered
-                    complies[block], new_hp[block], dv[block] = check.complies, check.new_perigee_m, check.dv_m_s
+                    _store_check(
+                        outputs, block, check_disposal_rule(perigee_m[block], apogee_m[block], rule_years, lifetimes)
+                    )
                 bar.update(block.size)
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:

@@ -372,13 +372,19 @@ class SolarDecayModel:
 
     def chunk_condition(self, t_days: float) -> tuple[DailyIndices, tuple[float, float]]:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""
-        samples = max(1, math.ceil(self.chunk_days))
-        # One sample at the start of each day: a daily table's rows are then taken as they are
-        # (midpoints would interpolate between two days and smooth the storms away).
-        days = self.start_days + t_days + np.arange(samples) * (self.chunk_days / samples)
+        days = self.chunk_samples(t_days)
         daily = self.daily_indices(days)
         _, f107a, ap = self.activity.indices(days)
         return daily, bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step)
+
+    def chunk_samples(self, t_days: float) -> FloatArray:
+        """The Unix days at which the chunk starting ``t_days`` after the start is sampled.
+
+        One sample at the start of each day: a daily table's rows are then taken as they
+        are (midpoints would interpolate between two days and smooth the storms away).
+        """
+        samples = max(1, math.ceil(self.chunk_days))
+        return self.start_days + t_days + np.arange(samples) * (self.chunk_days / samples)
 
     def daily_indices(self, days: FloatArray) -> DailyIndices:
         """(F10.7, 81-day mean, Ap, day of the year) at each of ``days`` (Unix days), rounded for the caches.
@@ -507,9 +513,7 @@ class SolarDecayModel:
         day of the year, orbit-averaged at the inclinations ``anchors_deg`` in one call
         (cached), combined by ``basis`` (satellites, anchors: `inclination_basis`).
         """
-        samples = max(1, math.ceil(self.chunk_days))
-        days = self.start_days + t_days + np.arange(samples) * (self.chunk_days / samples)
-        f107, f107a, ap = (round(float(np.mean(x)), 1) for x in self.activity.indices(days))
+        f107, f107a, ap = (round(float(np.mean(x)), 1) for x in self.activity.indices(self.chunk_samples(t_days)))
         middle = self.start_days + t_days + 0.5 * self.chunk_days
         doy = float(np.clip(2.0 * np.round(day_of_year(middle) / 2.0), 1.0, 366.0)) if self.follow_season else None
         log_rho = _anchor_log_density(
