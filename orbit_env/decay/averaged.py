@@ -111,27 +111,42 @@ class DecayModel:
         weights[[0, -1]] = 1.0 / n
         return np.cos(half), np.sin(half), weights
 
-    def rates_per_nu(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:
-        """Orbit-averaged dp/dnu [m / (m^3 kg^-1 s^-2)] and de/dnu, both negative.
+    def drag_kernels(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The heights [m] at the rule's anomalies and the kernels K_p, K_e of the orbit-averaged rates.
 
-        Broadcasts over the shapes of ``p_m`` and ``e``.
+        dp/dnu = sum(K_p rho(h)) and de/dnu = sum(K_e rho(h)) over the last axis, for any
+        density rho at those heights (`rates_per_nu` with this model's air). The kernels hold
+        the geometry, the air's speed, the rule's weights and the constants, so callers
+        that weigh one orbit under several densities compute them once. Shapes: those of
+        ``p_m`` and ``e`` broadcast, with the anomalies last.
         """
         p = np.asarray(p_m, dtype=np.float64)[..., None]
         ecc = np.asarray(e, dtype=np.float64)[..., None]
         cos, sin, weights = self._cos_sin
         k = 1.0 + ecc * cos
         r = p / k
-        rho = self.atmosphere.density_kg_m3(r - EARTH_RADIUS_M)
         v_scale = np.sqrt(MU_EARTH_M3_S2 / p)
         v_r = v_scale * ecc * sin
         v_n_rel = v_scale * k - self.corotation_rad_s * r
         speed = np.sqrt(v_r * v_r + v_n_rel * v_n_rel)
-        drag = rho * speed / MU_EARTH_M3_S2
-        dp = (r * r * r * drag * v_n_rel) @ weights
-        de = (0.5 * r * r * drag * (sin * v_r + ((1.0 + 1.0 / k) * cos + ecc / k) * v_n_rel)) @ weights
         # Int_0^2pi = 2 pi * mean; the minus sign is drag; 1/g turns dN into dnu/(c).
-        factor = -2.0 * np.pi / G0_M_S2
-        return factor * dp, factor * de
+        drag = (-2.0 * np.pi / (G0_M_S2 * MU_EARTH_M3_S2)) * weights * speed * r * r
+        k_p = drag * r * v_n_rel
+        k_e = 0.5 * drag * (sin * v_r + ((1.0 + 1.0 / k) * cos + ecc / k) * v_n_rel)
+        return r - EARTH_RADIUS_M, k_p, k_e
+
+    def rates_per_nu(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """Orbit-averaged dp/dnu [m / (m^3 kg^-1 s^-2)] and de/dnu, both negative.
+
+        Broadcasts over the shapes of ``p_m`` and ``e``.
+        """
+        height_m, k_p, k_e = self.drag_kernels(p_m, e)
+        return kernel_rates(k_p, k_e, self.atmosphere.density_kg_m3(height_m))
+
+
+def kernel_rates(k_p: FloatArray, k_e: FloatArray, rho_kg_m3: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """dp/dnu and de/dnu from `DecayModel.drag_kernels` and the density at its heights (broadcasting)."""
+    return np.einsum("...j,...j->...", k_p, rho_kg_m3), np.einsum("...j,...j->...", k_e, rho_kg_m3)
 
 
 @dataclass(frozen=True)

@@ -77,7 +77,7 @@ from orbit_env.constants import (
     REENTRY_ALTITUDE_M,
     SECONDS_PER_DAY,
 )
-from orbit_env.decay.averaged import DecayModel
+from orbit_env.decay.averaged import DecayModel, kernel_rates
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import SolarActivity, day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
@@ -303,32 +303,24 @@ def life_rate_ratio(
     """
     model = curves.model
     reference = model.atmosphere
-    last: list[FloatArray] = []
-
-    def row_density(h: FloatArray) -> FloatArray:
-        # h is (rows, ..., anomalies): each row reads its own table. In co-rotating air the calls ask
-        # for the same heights: the density is computed once.
-        if last and np.array_equal(last[0], h):
-            return last[1]
-        rho = np.asarray(reference.density_kg_m3(h) * np.exp(interpolate_rows(log_ratio, grid_m, h)), dtype=np.float64)
-        last[:] = [h, rho]
-        return rho
-
     p, e = elements_from_heights(perigee_m, apogee_m)
     e = np.maximum(e, 0.0)
-    extra = (1,) * (np.ndim(perigee_m) - 1)
-    if model.rotating_atmosphere and inclination_deg is not None:
-        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64))).reshape(-1, *extra)
-        weights, nodes_deg = (1.0 - cos_i, cos_i), (90.0, 0.0)
-    else:
-        weights, nodes_deg = (np.ones((1, *extra)),), (model.inclination_deg,)
-    dp_row, de_row = np.zeros(np.shape(p)), np.zeros(np.shape(p))
-    air = FunctionAtmosphere(row_density)
-    for weight, node in zip(weights, nodes_deg, strict=True):
-        node_dp, node_de = DecayModel(air, model.rotating_atmosphere, node, quadrature_points).rates_per_nu(p, e)
-        dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
     own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
-    dp_ref, de_ref = own.rates_per_nu(p, e)
+    height_m, k_p, k_e = own.drag_kernels(p, e)
+    rho_ref = reference.density_kg_m3(height_m)
+    # Heights (rows, ..., anomalies): each row reads its own table.
+    rho_row = rho_ref * np.exp(interpolate_rows(log_ratio, grid_m, height_m))
+    dp_ref, de_ref = kernel_rates(k_p, k_e, rho_ref)
+    if model.rotating_atmosphere and inclination_deg is not None:
+        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
+        cos_i = cos_i.reshape(-1, *((1,) * (np.ndim(perigee_m) - 1)))
+        dp_row, de_row = np.zeros(np.shape(p)), np.zeros(np.shape(p))
+        for weight, node_deg in ((1.0 - cos_i, 90.0), (cos_i, 0.0)):
+            _, node_p, node_e = DecayModel(reference, True, node_deg, quadrature_points).drag_kernels(p, e)
+            node_dp, node_de = kernel_rates(node_p, node_e, rho_row)
+            dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
+    else:  # the rows' air moves as the curves' (still, or at their inclination)
+        dp_row, de_row = kernel_rates(k_p, k_e, rho_row)
     w0 = SolarDecayModel.weight_of(curves, p, e) if weighted is None else weighted
     w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
     w_e = (w0 - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
