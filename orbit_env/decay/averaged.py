@@ -41,6 +41,7 @@ which make the rule second order there), measured in
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -120,19 +121,34 @@ class DecayModel:
         that weigh one orbit under several densities compute them once. Shapes: those of
         ``p_m`` and ``e`` broadcast, with the anomalies last.
         """
+        height_m, k_p, k_e = self.drag_kernels_in_air(p_m, e, (self.corotation_rad_s,))
+        return height_m, k_p[0], k_e[0]
+
+    def drag_kernels_in_air(
+        self, p_m: ArrayLike, e: ArrayLike, air_rad_s: Sequence[float]
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """`drag_kernels` in air turning at each of ``air_rad_s`` (Omega cos i) instead of the model's.
+
+        The kernels gain a leading axis, one entry per air speed; the geometry is shared.
+        """
         p = np.asarray(p_m, dtype=np.float64)[..., None]
         ecc = np.asarray(e, dtype=np.float64)[..., None]
         cos, sin, weights = self._cos_sin
         k = 1.0 + ecc * cos
         r = p / k
         v_scale = np.sqrt(MU_EARTH_M3_S2 / p)
-        v_r = v_scale * ecc * sin
-        v_n_rel = v_scale * k - self.corotation_rad_s * r
-        speed = np.sqrt(v_r * v_r + v_n_rel * v_n_rel)
+        v_r = (v_scale * ecc) * sin
+        v_r_squared, v_r_sin = v_r * v_r, v_r * sin
+        v_n = v_scale * k  # the transverse speed in still air
+        e_arm = cos + (cos + ecc) / k  # (1 + 1/k) cos + e/k
         # Int_0^2pi = 2 pi * mean; the minus sign is drag; 1/g turns dN into dnu/(c).
-        drag = (-2.0 * np.pi / (G0_M_S2 * MU_EARTH_M3_S2)) * weights * speed * r * r
-        k_p = drag * r * v_n_rel
-        k_e = 0.5 * drag * (sin * v_r + ((1.0 + 1.0 / k) * cos + ecc / k) * v_n_rel)
+        drag_r2 = ((-2.0 * np.pi / (G0_M_S2 * MU_EARTH_M3_S2)) * weights) * (r * r)
+        k_p, k_e = np.empty((len(air_rad_s), *r.shape)), np.empty((len(air_rad_s), *r.shape))
+        for index, air in enumerate(air_rad_s):
+            v_n_rel = v_n - air * r if air else v_n
+            drag = drag_r2 * np.sqrt(v_r_squared + v_n_rel * v_n_rel)
+            k_p[index] = drag * r * v_n_rel
+            k_e[index] = 0.5 * drag * (v_r_sin + e_arm * v_n_rel)
         return r - EARTH_RADIUS_M, k_p, k_e
 
     def rates_per_nu(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:

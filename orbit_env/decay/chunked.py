@@ -306,21 +306,21 @@ def life_rate_ratio(
     p, e = elements_from_heights(perigee_m, apogee_m)
     e = np.maximum(e, 0.0)
     own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
-    height_m, k_p, k_e = own.drag_kernels(p, e)
+    rows_turn = model.rotating_atmosphere and inclination_deg is not None
+    # The air's speeds: the curves' own, and for rows at their inclinations cos i = 0 and 1.
+    air_rad_s = (own.corotation_rad_s, 0.0, EARTH_ROTATION_RAD_S) if rows_turn else (own.corotation_rad_s,)
+    height_m, k_p, k_e = own.drag_kernels_in_air(p, e, air_rad_s)
     rho_ref = reference.density_kg_m3(height_m)
     # Heights (rows, ..., anomalies): each row reads its own table.
     rho_row = rho_ref * np.exp(interpolate_rows(log_ratio, grid_m, height_m))
-    dp_ref, de_ref = kernel_rates(k_p, k_e, rho_ref)
-    if model.rotating_atmosphere and inclination_deg is not None:
+    dp_ref, de_ref = kernel_rates(k_p[0], k_e[0], rho_ref)
+    if rows_turn:  # each row's cos i on the line through the rates at cos i = 0 and 1
         cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
         cos_i = cos_i.reshape(-1, *((1,) * (np.ndim(perigee_m) - 1)))
-        dp_row, de_row = np.zeros(np.shape(p)), np.zeros(np.shape(p))
-        for weight, node_deg in ((1.0 - cos_i, 90.0), (cos_i, 0.0)):
-            _, node_p, node_e = DecayModel(reference, True, node_deg, quadrature_points).drag_kernels(p, e)
-            node_dp, node_de = kernel_rates(node_p, node_e, rho_row)
-            dp_row, de_row = dp_row + weight * node_dp, de_row + weight * node_de
+        (dp_90, dp_0), (de_90, de_0) = kernel_rates(k_p[1:], k_e[1:], rho_row)
+        dp_row, de_row = (1.0 - cos_i) * dp_90 + cos_i * dp_0, (1.0 - cos_i) * de_90 + cos_i * de_0
     else:  # the rows' air moves as the curves' (still, or at their inclination)
-        dp_row, de_row = kernel_rates(k_p, k_e, rho_row)
+        dp_row, de_row = kernel_rates(k_p[0], k_e[0], rho_row)
     w0 = SolarDecayModel.weight_of(curves, p, e) if weighted is None else weighted
     w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
     w_e = (w0 - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
