@@ -35,6 +35,31 @@ def test_quadrature_is_converged():
     np.testing.assert_allclose(coarse[1][1:], fine[1][1:], rtol=3e-4)
 
 
+def test_kernels_in_several_air_speeds_are_each_inclinations_own():
+    # drag_kernels_in_air shares one geometry between air speeds; each speed's kernels must be
+    # those of the model at the inclination with that speed (Omega cos i), and the still-air ones
+    # those of a still-air model. Same arithmetic in another order: 1e-12 relative.
+    hp = np.array([150e3, 300e3, 600e3])
+    p, e = elements_from_heights(hp, hp + np.array([0.0, 500e3, 1500e3]))
+    base = DecayModel(rotating_atmosphere=True, inclination_deg=51.6, quadrature_points=12)
+    inclinations = (51.6, 90.0, 0.0, 120.0)
+    models = [DecayModel(rotating_atmosphere=True, inclination_deg=i, quadrature_points=12) for i in inclinations]
+    height_m, k_p, k_e = base.drag_kernels_in_air(p, e, [m.corotation_rad_s for m in models])
+    for index, model in enumerate(models):
+        own_height_m, own_p, own_e = model.drag_kernels(p, e)
+        np.testing.assert_allclose(height_m, own_height_m, rtol=1e-12)
+        np.testing.assert_allclose(k_p[index], own_p, rtol=1e-12)
+        np.testing.assert_allclose(k_e[index], own_e, rtol=1e-12, atol=1e-12 * np.abs(own_e).max())
+    still = DecayModel(quadrature_points=12).drag_kernels(p, e)
+    np.testing.assert_allclose(k_p[1], still[1], rtol=1e-12)
+    # The kernels times the density are the rates.
+    rho = base.atmosphere.density_kg_m3(height_m)
+    dp, de = models[3].rates_per_nu(p, e)
+    np.testing.assert_allclose((k_p[3] * rho).sum(-1), dp, rtol=1e-12)
+    # de/dnu of the circular orbit is round-off (as above): absolute, on the scale of dp/dnu / p.
+    np.testing.assert_allclose((k_e[3] * rho).sum(-1), de, rtol=1e-12, atol=1e-12 * np.abs(dp / p).max())
+
+
 def test_eccentricity_and_parameter_fall():
     hp = np.linspace(120e3, 1000e3, 30)
     p, e = elements_from_heights(hp, hp + 500e3)
