@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from orbit_env.analysis.lifetime import lifetime
-from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, G0_M_S2, MU_EARTH_M3_S2
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.paper.table2 import calibrate_rho100, compare_table2
 from orbit_env.physics.atmosphere import RHO100_CALIBRATED_KG_M3
@@ -37,8 +37,8 @@ def test_quadrature_is_converged():
 
 def test_kernels_in_several_air_speeds_are_each_inclinations_own():
     # drag_kernels_in_air shares one geometry between air speeds; each speed's kernels must be
-    # those of the model at the inclination with that speed (Omega cos i), and the still-air ones
-    # those of a still-air model. Same arithmetic in another order: 1e-12 relative.
+    # those of the model at the inclination with that speed (Omega cos i): the same operations
+    # on the same numbers, so 1e-12 relative.
     hp = np.array([150e3, 300e3, 600e3])
     p, e = elements_from_heights(hp, hp + np.array([0.0, 500e3, 1500e3]))
     base = DecayModel(rotating_atmosphere=True, inclination_deg=51.6, quadrature_points=12)
@@ -52,12 +52,19 @@ def test_kernels_in_several_air_speeds_are_each_inclinations_own():
         np.testing.assert_allclose(k_e[index], own_e, rtol=1e-12, atol=1e-12 * np.abs(own_e).max())
     still = DecayModel(quadrature_points=12).drag_kernels(p, e)
     np.testing.assert_allclose(k_p[1], still[1], rtol=1e-12)
-    # The kernels times the density are the rates.
-    rho = base.atmosphere.density_kg_m3(height_m)
-    dp, de = models[3].rates_per_nu(p, e)
-    np.testing.assert_allclose((k_p[3] * rho).sum(-1), dp, rtol=1e-12)
-    # de/dnu of the circular orbit is round-off (as above): absolute, on the scale of dp/dnu / p.
-    np.testing.assert_allclose((k_e[3] * rho).sum(-1), de, rtol=1e-12, atol=1e-12 * np.abs(dp / p).max())
+
+
+def test_corotating_rates_of_circular_orbits_in_closed_form():
+    # e = 0 in air turning at w = Omega cos i: the air's speed is v - w p, v = sqrt(mu/p), so
+    # dp/dnu = -(2 pi / g) p^2 rho(p - R) (1 - w p / v)^2, independent of the kernels' algebra.
+    # Every anomaly sees the same height and speed: the quadrature is exact up to round-off.
+    p = EARTH_RADIUS_M + np.array([150e3, 300e3, 800e3])
+    for inclination_deg in (0.0, 51.6, 120.0):
+        model = DecayModel(rotating_atmosphere=True, inclination_deg=inclination_deg)
+        dp, _ = model.rates_per_nu(p, np.zeros(3))
+        rho = model.atmosphere.density_kg_m3(p - EARTH_RADIUS_M)
+        wind = EARTH_ROTATION_RAD_S * np.cos(np.radians(inclination_deg)) * p / np.sqrt(MU_EARTH_M3_S2 / p)
+        np.testing.assert_allclose(dp, -2 * np.pi / G0_M_S2 * p**2 * rho * (1.0 - wind) ** 2, rtol=1e-12)
 
 
 def test_eccentricity_and_parameter_fall():
