@@ -121,8 +121,9 @@ class DecayModel:
         that weigh one orbit under several densities compute them once. Shapes: those of
         ``p_m`` and ``e`` broadcast, with the anomalies last.
         """
-        height_m, k_p, k_e = self.drag_kernels_in_air(p_m, e, (self.corotation_rad_s,))
-        return height_m, k_p[0], k_e[0]
+        geometry = self._kernel_geometry(p_m, e)
+        k_p, k_e = _kernels_in_air(geometry, self.corotation_rad_s)
+        return geometry[0] - EARTH_RADIUS_M, k_p, k_e
 
     def drag_kernels_in_air(
         self, p_m: ArrayLike, e: ArrayLike, air_rad_s: Sequence[float]
@@ -131,6 +132,13 @@ class DecayModel:
 
         The kernels gain a leading axis, one entry per air speed; the geometry is shared.
         """
+        geometry = self._kernel_geometry(p_m, e)
+        kernels = [_kernels_in_air(geometry, air) for air in air_rad_s]
+        k_p, k_e = (np.stack(k) for k in zip(*kernels, strict=True))
+        return geometry[0] - EARTH_RADIUS_M, k_p, k_e
+
+    def _kernel_geometry(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, ...]:
+        """What the kernels share across air speeds: r, v_r^2, v_r sin, the still-air v_n, the arm of de, drag r^2."""
         p = np.asarray(p_m, dtype=np.float64)[..., None]
         ecc = np.asarray(e, dtype=np.float64)[..., None]
         cos, sin, weights = self._cos_sin
@@ -138,18 +146,10 @@ class DecayModel:
         r = p / k
         v_scale = np.sqrt(MU_EARTH_M3_S2 / p)
         v_r = (v_scale * ecc) * sin
-        v_r_squared, v_r_sin = v_r * v_r, v_r * sin
-        v_n = v_scale * k  # the transverse speed in still air
         e_arm = cos + (cos + ecc) / k  # (1 + 1/k) cos + e/k
         # Int_0^2pi = 2 pi * mean; the minus sign is drag; 1/g turns dN into dnu/(c).
         drag_r2 = ((-2.0 * np.pi / (G0_M_S2 * MU_EARTH_M3_S2)) * weights) * (r * r)
-        k_p, k_e = np.empty((len(air_rad_s), *r.shape)), np.empty((len(air_rad_s), *r.shape))
-        for index, air in enumerate(air_rad_s):
-            v_n_rel = v_n - air * r if air else v_n
-            drag = drag_r2 * np.sqrt(v_r_squared + v_n_rel * v_n_rel)
-            k_p[index] = drag * r * v_n_rel
-            k_e[index] = 0.5 * drag * (v_r_sin + e_arm * v_n_rel)
-        return r - EARTH_RADIUS_M, k_p, k_e
+        return r, v_r * v_r, v_r * sin, v_scale * k, e_arm, drag_r2
 
     def rates_per_nu(self, p_m: ArrayLike, e: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """Orbit-averaged dp/dnu [m / (m^3 kg^-1 s^-2)] and de/dnu, both negative.
@@ -163,6 +163,14 @@ class DecayModel:
 def kernel_rates(k_p: FloatArray, k_e: FloatArray, rho_kg_m3: ArrayLike) -> tuple[FloatArray, FloatArray]:
     """dp/dnu and de/dnu from `DecayModel.drag_kernels` and the density at its heights (broadcasting)."""
     return np.einsum("...j,...j->...", k_p, rho_kg_m3), np.einsum("...j,...j->...", k_e, rho_kg_m3)
+
+
+def _kernels_in_air(geometry: tuple[FloatArray, ...], air_rad_s: float) -> tuple[FloatArray, FloatArray]:
+    """K_p and K_e of `DecayModel.drag_kernels` from its shared geometry, in air turning at ``air_rad_s``."""
+    r, v_r_squared, v_r_sin, v_n, e_arm, drag_r2 = geometry
+    v_n_rel = v_n - air_rad_s * r if air_rad_s else v_n  # the transverse speed through the air
+    drag = drag_r2 * np.sqrt(v_r_squared + v_n_rel * v_n_rel)
+    return drag * r * v_n_rel, 0.5 * drag * (v_r_sin + e_arm * v_n_rel)
 
 
 @dataclass(frozen=True)
