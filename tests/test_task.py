@@ -126,3 +126,61 @@ def test_one_satellite_and_a_batch_of_one_are_the_same_task():
         assert one.reward == pytest.approx(float(many.reward[0]), rel=1e-9)
         assert one.burn_m_s == pytest.approx(float(many.burn_m_s[0]), rel=ROUND_OFF)
         np.testing.assert_allclose(task_model.observe(task, single), task_model.observe(task, batch)[0], rtol=1e-6)
+
+
+@pytest.mark.parametrize("path", ["numpy", "compiled", "single"])
+def test_a_vanishing_burn_is_no_burn(path):
+    """The return is continuous in the burn: no jump to where table A locates the heights.
+
+    Before burns moved orbits by table A's difference (``UniversalCurves.relocate_segments``),
+    a burn of 1e-9 m/s put the orbit where table A locates its heights, which tables A and B
+    disagree on by up to 1.3 km of apogee: worth 0.02 to 0.14 day of a year's return from the
+    starts checked, which a search over burn plans harvested with many small burns. Now
+    1e-9 m/s changes the return by about 1e-9 days per (day per m/s): 1e-6 day allows for the
+    round-off of a year's sum of coasts (365 differences of W values of ~1e4 days, 1e-12 relative).
+    A burn of 1 m/s still moves it (the check is not vacuous).
+    """
+    from orbit_env.envs import kernel as kernel_module
+
+    task = Task.of(continuous=True)
+    states = task_model.start(task, np.random.default_rng(3), 64)
+    horizon = task.config.horizon_steps
+    limit = kernel_module.MAX_COMPILED_ROWS
+    if path == "compiled" and kernel_module.compiled() is None:
+        pytest.skip("needs numba")
+    kernel_module.MAX_COMPILED_ROWS = -1 if path == "numpy" else limit
+
+    def year(burn):
+        if path == "single":
+            ones = [task_model.start(task, np.random.default_rng(seed)) for seed in range(16)]
+            return np.array([task_model.lookahead(task, one, burn, horizon)[0] for one in ones])
+        return task_model.lookahead(task, states, burn, horizon)[0]
+
+    try:
+        coast, tiny, small = year(0.0), year(1e-9), year(1.0)
+    finally:
+        kernel_module.MAX_COMPILED_ROWS = limit
+    np.testing.assert_allclose(tiny, coast, rtol=0.0, atol=1e-6)
+    assert np.abs(small - coast).max() > 0.1
+
+
+def test_decode_recovers_the_env_s_point_on_the_curves():
+    """`decode` finds the point whose table-B heights the env showed (`UniversalCurves.locate_exactly`).
+
+    Table A's point of those heights was up to about 0.1% off in nu (the tables disagree
+    by up to 1.3 km of apogee). What is left is the observation's float32 rounding: heights
+    over HEIGHT_SCALE_M to 6e-8 relative, some 0.1 m of apogee, 5e-7 of nu measured on
+    5000 satellites; 2e-6 allows for that.
+    """
+    task = Task.of(continuous=True)
+    rng = np.random.default_rng(4)
+    states = task_model.start(task, rng, 2000)
+    for _ in range(40):
+        task_model.step(task, states, rng.uniform(0.0, 30.0, states.size) * (rng.random(states.size) < 0.1))
+    alive = states.tau > 0.0
+    decoded = task_model.decode(task, task_model.observe(task, states))
+    np.testing.assert_allclose(decoded.nu[alive], states.nu[alive], rtol=2e-6)
+    np.testing.assert_allclose(decoded.label[alive], states.label[alive], rtol=0.0, atol=1e-5)
+    # Table A's point alone is further off than that: the check has teeth.
+    _, tau_a = task.curves._label_tau(decoded.perigee_m[alive], decoded.apogee_m[alive])
+    assert np.abs(np.expm1(tau_a) / np.expm1(states.tau[alive]) - 1.0).max() > 1e-4

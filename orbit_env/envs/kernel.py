@@ -72,20 +72,33 @@ def _cell(cells: FloatArray, grid: FloatArray, x: float, y: float) -> tuple[int,
     return i * int(grid[_NY]) + j, fx - i, j, fy - j
 
 
-def _locate(
-    data: FloatArray, k: int, a_cells: FloatArray, a_grid: FloatArray, b_cells: FloatArray, b_grid: FloatArray
-) -> None:
-    """`task.place` of row ``k`` at its perigee and apogee rows: label, tau, nu, mean period, heights, cell."""
-    rp = EARTH_RADIUS_M + data[_PERIGEE, k]
-    ra = EARTH_RADIUS_M + data[_APOGEE, k]
+def _table_a_point(perigee_m: float, apogee_m: float, a_cells: FloatArray, a_grid: FloatArray) -> tuple[float, float]:
+    """`UniversalCurves._label_tau` of one orbit: table A's (label, tau), bilinear (`_Grid.values`' grouping)."""
+    rp = EARTH_RADIUS_M + perigee_m
+    ra = EARTH_RADIUS_M + apogee_m
     y = math.log(max((ra - rp) / (ra + rp), E_FLOOR))
-    # Table A: mu - ln e and tau, bilinear (`_Grid.values`, the same grouping of terms).
-    row, tx, _, ty = _cell(a_cells, a_grid, data[_PERIGEE, k], y)
+    row, tx, _, ty = _cell(a_cells, a_grid, perigee_m, y)
     txy = tx * ty
     a0 = a_cells[row, 0, 1] * tx + a_cells[row, 0, 0] + a_cells[row, 0, 2] * ty + a_cells[row, 0, 3] * txy
     a1 = a_cells[row, 1, 1] * tx + a_cells[row, 1, 0] + a_cells[row, 1, 2] * ty + a_cells[row, 1, 3] * txy
-    label = y + a0
-    tau = max(a1, 0.0)
+    return y + a0, max(a1, 0.0)
+
+
+def _relocate(
+    data: FloatArray,
+    k: int,
+    apogee_after_m: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+) -> None:
+    """`task.place_burnt` of row ``k``: moved by table A's difference, then label, tau, nu, period, heights, cell."""
+    perigee = data[_PERIGEE, k]
+    before_label, before_tau = _table_a_point(perigee, data[_APOGEE, k], a_cells, a_grid)
+    after_label, after_tau = _table_a_point(perigee, apogee_after_m, a_cells, a_grid)
+    label = data[_LABEL, k] + (after_label - before_label)
+    tau = max(data[_TAU, k] + (after_tau - before_tau), 0.0)
     data[_LABEL, k] = label
     data[_TAU, k] = tau
     data[_NU, k] = NU_REF * math.expm1(tau)
@@ -157,7 +170,7 @@ def _burn(
 ) -> float:
     """`task.burn` of row ``k`` (asked to burn, and able to).
 
-    `task.perigee_burn`, the new mass, `task.update_satellite` and `task.place`.
+    `task.perigee_burn`, the new mass, `task.update_satellite` and `task.place_burnt`.
     """
     mass, dry, exhaust = data[_MASS, k], data[_DRY, k], data[_EXHAUST, k]
     perigee, apogee = data[_PERIGEE, k], data[_APOGEE, k]
@@ -175,8 +188,7 @@ def _burn(
     data[_DV_LEFT, k] = max(exhaust * math.log(mass / dry), 0.0)
     data[_NOMINAL_W, k] = G0_M_S2 * (data[_AREA, k] / mass * p[_NOMINAL_S_DAY])
     _update_density(data, k, p)
-    data[_APOGEE, k] = min(apogee_after, CURVES_MAX_APOGEE_M)
-    _locate(data, k, a_cells, a_grid, b_cells, b_grid)
+    _relocate(data, k, min(apogee_after, CURVES_MAX_APOGEE_M), a_cells, a_grid, b_cells, b_grid)
     return dv
 
 
@@ -348,7 +360,8 @@ def compiled() -> _Kernels | None:
         import numba
     except ImportError:
         return None
-    helpers = (_cell, _locate, _new_segment, _heights_on_segment, _perigee_speed_m_s, _apogee_after_m, _sine)
+    helpers = (_cell, _table_a_point, _relocate, _new_segment, _heights_on_segment)
+    helpers += (_perigee_speed_m_s, _apogee_after_m, _sine)
     for helper in (*helpers, _set_density_scale, _update_density, _burn):
         # Callable from the compiled loops, unchanged from Python. Not inlined by numba (that took the
         # first compilation from 4.7 s to 25 s); LLVM inlines the small ones, so the loops stay SIMD.

@@ -691,7 +691,7 @@ def update_density(task: Task, state: AnyState, drag_parameter: Any = None) -> N
 
 
 def place(task: Task, state: AnyState, perigee_m: Any, apogee_m: Any) -> None:
-    """Locate new orbits (a start, a burn) on the curves and take their heights as the curves give them.
+    """Locate new orbits (a start) on the curves and take their heights as the curves give them.
 
     The heights then come from the same table before and after every coast, so the
     observed decay of a step is never the locate-and-read-back round trip's
@@ -699,7 +699,25 @@ def place(task: Task, state: AnyState, perigee_m: Any, apogee_m: Any) -> None:
     """
     if isinstance(state, TaskState):
         perigee_m, apogee_m = float(perigee_m), float(apogee_m)
-    point, state.perigee_m, state.apogee_m, state.segments = task.curves.locate_segments(perigee_m, apogee_m)
+    _put_point(state, *task.curves.locate_segments(perigee_m, apogee_m))
+
+
+def place_burnt(task: Task, state: AnyState, apogee_after_m: Any) -> None:
+    """Move orbits whose apogee a perigee burn raised to ``apogee_after_m`` onto their new curve.
+
+    From their point on the curves, continuously in the burn
+    (``UniversalCurves.relocate_segments``: a tiny burn is nearly no burn, not a
+    jump to where table A locates the heights).
+    """
+    if isinstance(state, TaskState):
+        apogee_after_m = float(apogee_after_m)
+    moved = task.curves.relocate_segments(state.label, state.tau, state.perigee_m, state.apogee_m, apogee_after_m)
+    _put_point(state, *moved)
+
+
+def _put_point(state: AnyState, point: CurvePoint, perigee_m: Any, apogee_m: Any, segments: Any) -> None:
+    """Set a state's place on the curves, its heights and its cell of table B."""
+    state.perigee_m, state.apogee_m, state.segments = perigee_m, apogee_m, segments
     state.label = point.label
     state.tau = point.tau
     state.nu = point.nu
@@ -740,7 +758,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
         if dv > 0.0:
             state.mass_kg = float(mass_kg)
             update_satellite(task, state)
-            place(task, state, state.perigee_m, apogee_m)
+            place_burnt(task, state, apogee_m)
         return dv
     asked = np.flatnonzero(np.minimum(requested_dv_m_s, state.dv_left_m_s) > 0.0)  # asked to burn, and able to
     compiled = None
@@ -764,7 +782,7 @@ def burn(task: Task, state: AnyState, requested_dv_m_s: Any) -> Any:
             made[asked] = dv
             firing.mass_kg = mass_kg
             update_satellite(task, firing)
-            place(task, firing, firing.perigee_m, apogee_m)
+            place_burnt(task, firing, apogee_m)
             state.put(asked, firing)
     return made
 
@@ -908,7 +926,8 @@ def observation_batch(observation: Any) -> FloatArray:
 def decode(task: Task, observation: Any) -> BatchState:
     """The states a planner recovers from observations (7,) or (n, 7), as a ground station would.
 
-    The orbit from the observed heights (located on the curves), the mass from the
+    The orbit from the observed heights (the point of the curves whose heights they
+    are, `UniversalCurves.locate_exactly`), the mass from the
     delta-v left and the config's satellite (rocket equation), the steps taken from
     the mission clock, and the nominal density of ``task`` (see
     `Task.planning`). Heights are clipped into the curves' domain.
@@ -922,7 +941,9 @@ def decode(task: Task, observation: Any) -> BatchState:
     dv_left = np.maximum(obs[:, OBS_INDEX["delta_v_left"]] * DV_SCALE_M_S, 0.0)
     horizon = task.config.horizon_steps
     steps = np.rint(np.clip(obs[:, OBS_INDEX["mission_clock"]], 0.0, 1.0) * horizon)
-    return states_at_orbits(task, perigee_m, apogee_m, dv_left, steps)
+    # The point whose table-B heights the env showed, not table A's point of them (see locate_exactly).
+    label, tau = task.curves.locate_exactly(perigee_m, apogee_m)
+    return states_on_curves(task, label, tau, dv_left, steps)
 
 
 def outlives(task: Task, state: AnyState, steps: ArrayLike) -> Any:
