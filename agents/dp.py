@@ -844,9 +844,6 @@ class DPPolicy:
             is taken. Deterministic: it earns at least the base's return from the state it
             plans from, up to the continuations it cannot follow later (see docs/dp.md).
         rollout_steps: The steps from the mission's start in which the rollout decides.
-        refine_m_s: With ``rollout``, burn sizes off the config's: after the best of the
-            config's burns, b +- h for each h in turn (clipped to 0..max burn) replaces it
-            where it earns more (the continuous variant).
     """
 
     name = "dp"
@@ -861,7 +858,6 @@ class DPPolicy:
         lookahead: int = 1,
         rollout: int = 0,
         rollout_steps: int = ROLLOUT_STEPS,
-        refine_m_s: tuple[float, ...] = (),
     ) -> None:
         if lookahead not in (1, 2):
             raise ValueError(f"lookahead={lookahead!r} is invalid; allowed: 1 or 2")
@@ -873,15 +869,11 @@ class DPPolicy:
             )
         if not (isinstance(rollout_steps, (int, np.integer)) and rollout_steps >= 0):
             raise ValueError(f"rollout_steps={rollout_steps!r} is invalid; allowed: an integer >= 0")
-        refine = tuple(float(h) for h in refine_m_s)
-        if not all(math.isfinite(h) and h > 0.0 for h in refine) or (refine and not rollout):
-            raise ValueError(f"refine_m_s={refine_m_s!r} is invalid; allowed: sizes > 0 [m/s], with rollout")
         self.solution = solution if solution is not None else solve(config, grid=grid, density_scale=density_scale)
         self.config = self.solution.config
         self.lookahead = lookahead
         self.rollout = int(rollout)
         self.rollout_steps = int(rollout_steps)
-        self.refine_m_s = refine
 
     def burns_m_s(self, observation: Any) -> FloatArray:
         """The burns chosen for a batch of observations (n, 7) or one (7,), as an array (n,) [m/s]."""
@@ -924,22 +916,7 @@ class DPPolicy:
         best = np.argmax(first, axis=1)
         value = first[every, base]
         better = first[every, best] > value + ROLLOUT_TIE_DAYS
-        choice = np.where(better, sizes[best], base_m_s)
-        value = np.where(better, first[every, best], value)
-        for h in self.refine_m_s:
-            candidates = np.clip(choice[:, None] + np.array([-h, h]), 0.0, self.config.max_burn_m_s)
-            found = rollout_returns(
-                self.solution,
-                states.take(np.repeat(every, 2)),
-                candidates.reshape(-1, 1),
-                np.repeat(steps_left, 2),
-                self.rollout_steps,
-            ).reshape(n, 2)
-            j = np.argmax(found, axis=1)
-            better = found[every, j] > value + ROLLOUT_TIE_DAYS
-            choice = np.where(better, candidates[every, j], choice)
-            value = np.where(better, found[every, j], value)
-        return choice
+        return np.where(better, sizes[best], base_m_s)
 
     def predict(
         self,
@@ -950,8 +927,7 @@ class DPPolicy:
     ) -> tuple[Any, Any]:
         """Actions for one observation (7,) or a batch (n, 7); SB3's signature.
 
-        The index of the config's burn size nearest the chosen burn (the burn itself,
-        off the config's sizes with ``refine_m_s``: see `burns_m_s`).
+        The index of the config's burn size chosen (`burns_m_s`).
         """
         burns = self.burns_m_s(observation)
         actions = np.abs(burns[:, None] - np.asarray(self.config.burn_sizes_m_s)).argmin(axis=1).astype(np.int64)

@@ -469,9 +469,10 @@ def dp_policy(env_id: str, lookahead: int = 1, rollout: bool = False) -> Predict
     The continuous variant's DP chooses among burns spaced by `CONTINUOUS_DP_STEP_M_S`:
     a lower bound on its optimum, converging as the spacing shrinks (see the constant).
     ``lookahead``: see `orbit_env.agents.dp.DPPolicy` (not for the oracle). ``rollout``:
-    the rollout policy on the DP (`DPPolicy`'s ``rollout``): over pairs of burns
-    (`ROLLOUT_DEPTH`) in the discrete variant; over single burns refined by
-    `CONTINUOUS_ROLLOUT_REFINE_M_S` in the continuous one. Not for the oracle.
+    the rollout policy on the DP (`DPPolicy`'s ``rollout``) over pairs of burns
+    (`ROLLOUT_DEPTH`) in the discrete variant; in the continuous one the DP's plans
+    refined by a search over burn sizes and played (`orbit_env.agents.plan.PlanPolicy`).
+    Not for the oracle.
     """
     from orbit_env.agents.dp import DPPolicy
 
@@ -484,8 +485,11 @@ def dp_policy(env_id: str, lookahead: int = 1, rollout: bool = False) -> Predict
     if base.continuous:
         sizes = continuous_dp_burns(base.config.max_burn_m_s)
         fine = dataclasses.replace(base.config, burn_sizes_m_s=sizes)
-        extra: dict[str, Any] = {"rollout": 1, "refine_m_s": CONTINUOUS_ROLLOUT_REFINE_M_S} if rollout else {}
-        policy = DPPolicy(fine, density_scale=scale, lookahead=lookahead, **extra)
+        policy = DPPolicy(fine, density_scale=scale, lookahead=lookahead)
+        if rollout:
+            from orbit_env.agents.plan import PlanPolicy
+
+            return PlanPolicy(policy)
         return ContinuousFromDiscrete(policy, sizes, base.config.max_burn_m_s)
     return DPPolicy(base.config, density_scale=scale, lookahead=lookahead, rollout=ROLLOUT_DEPTH if rollout else 0)
 
@@ -493,11 +497,6 @@ def dp_policy(env_id: str, lookahead: int = 1, rollout: bool = False) -> Predict
 #: Depth of the rollout policy on the discrete variant's DP: every pair of burns on the next two
 #: steps is played before the base policy (single burns leave starts beaten by up to 0.17 day).
 ROLLOUT_DEPTH = 2
-#: The continuous variant's rollout: after the best of the DP's 10 m/s burns, b +- 5, then
-#: +- 2.5, then +- 1.25 m/s (pairs of its 11 burns would cost 11 times the single burns).
-CONTINUOUS_ROLLOUT_REFINE_M_S = (5.0, 2.5, 1.25)
-
-
 #: Spacing of the burn sizes the DP of the continuous variant chooses from [m/s]. Measured on the
 #: 1000 evaluation episodes (seed 12345, grid (192, 1, 1)), realized mean return: 278.16 (20 m/s,
 #: solve 12 s, 1.1 GB), 278.41 (10 m/s, 60 s, 2.8 GB), 278.57 (5 m/s, 186 s, 7.3 GB); docs/dp.md.

@@ -337,8 +337,6 @@ def test_the_rollout_policy_checks_its_arguments_and_acts_in_the_discrete_space(
     for kwargs, match in (
         ({"rollout": 3}, "rollout=3 is invalid"),
         ({"rollout": 1, "lookahead": 2}, "lookahead=2 with rollout=1"),
-        ({"refine_m_s": (5.0,)}, "refine_m_s"),
-        ({"rollout": 1, "refine_m_s": (-1.0,)}, "refine_m_s"),
         ({"rollout": 1, "rollout_steps": -1}, "rollout_steps"),
     ):
         with pytest.raises(ValueError, match=match):
