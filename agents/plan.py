@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -192,13 +193,8 @@ class PlanPolicy:
         horizon = self.config.horizon_steps
         steps_left = int(horizon - states.steps.min())
         track = np.empty((states.size, steps_left + 1, 3))
-        s = states.copy()
-        for t in range(steps_left):
+        for t, s, _ in self._walk(states, burns, steps_left):
             track[:, t] = _features(s)
-            going = (s.tau > 0.0) & (s.steps < horizon)
-            burn = burns[:, t] if t < burns.shape[1] else 0.0
-            task_model.step(self.task, s, np.where(going, burn, 0.0))
-        track[:, -1] = _features(s)
         plans = _Plans(start=states.steps.astype(np.intp), burns=burns, track=track)
         self._batches.append(plans)
         while sum(p.start.size for p in self._batches) > PLAN_CACHE_ROWS and len(self._batches) > 1:
@@ -232,16 +228,26 @@ class PlanPolicy:
         length = min(max(self.window, int(burned.max(initial=-1)) + 1), max(room, 1))
         return recorded[:, :length].copy()
 
+    def _walk(self, states: BatchState, burns: FloatArray, steps: int) -> Iterator[tuple[int, BatchState, FloatArray]]:
+        """A plan played from ``states``: (t, the state before step t, the return earned before it), t = 0..steps.
+
+        ``burns`` (rows, m) on consecutive steps, coasting past them; a satellite that
+        re-entered or reached the horizon stays. The state yielded is stepped in place
+        after it: copy what is kept.
+        """
+        horizon = self.config.horizon_steps
+        s, total = states.copy(), np.zeros(states.size)
+        for t in range(steps):
+            yield t, s, total
+            going = (s.tau > 0.0) & (s.steps < horizon)
+            burn = np.where(going, burns[:, t] if t < burns.shape[1] else 0.0, 0.0)
+            total = total + np.where(going, task_model.step(self.task, s, burn).reward, 0.0)
+        yield steps, s, total
+
     def _play(self, states: BatchState, burns: FloatArray) -> FloatArray:
         """Returns of burning ``burns`` (rows, m) from ``states`` on consecutive steps, then coasting to the end."""
-        horizon = self.config.horizon_steps
-        s = states.copy()
-        total = np.zeros(s.size)
-        for column in burns.T:
-            going = (s.tau > 0.0) & (s.steps < horizon)
-            result = task_model.step(self.task, s, np.where(going, column, 0.0))
-            total += np.where(going, result.reward, 0.0)
-        left = np.maximum(horizon - s.steps, 0.0)
+        *_, (_, s, total) = self._walk(states, burns, burns.shape[1])
+        left = np.maximum(self.config.horizon_steps - s.steps, 0.0)
         alive = (s.tau > 0.0) & (left > 0.0)
         if alive.any():
             total[alive] += task_model.lookahead(self.task, s.take(alive), 0.0, left[alive])[0]
@@ -253,12 +259,9 @@ class PlanPolicy:
         length = burns.shape[1]
         # The states before each step under the current plan, and the rewards earned before them.
         before, earned = [], np.zeros((states.size, length))
-        s, total = states.copy(), np.zeros(states.size)
-        for t in range(length):
+        for t, s, total in self._walk(states, burns, length - 1):
             before.append(s.copy())
             earned[:, t] = total
-            going = (s.tau > 0.0) & (s.steps < horizon)
-            total += np.where(going, task_model.step(self.task, s, np.where(going, burns[:, t], 0.0)).reward, 0.0)
         gained = 0.0
         for t in range(length - 1, -1, -1):
             at = before[t]

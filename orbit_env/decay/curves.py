@@ -583,11 +583,7 @@ class UniversalCurves:
 
         For two floats (one orbit): floats, and the cell as a list (`_Grid.segment_scalar`).
         """
-        if isinstance(perigee_m, float) and isinstance(apogee_m, float):
-            return self._segments_at(*self._label_tau(perigee_m, apogee_m))
-        return self._segments_at(
-            *self._label_tau(np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64))
-        )
+        return self._segments_at(*self._label_tau(perigee_m, apogee_m))
 
     def relocate_segments(
         self, label: ArrayLike, tau: ArrayLike, perigee_m: ArrayLike, apogee_m: ArrayLike, apogee_after_m: ArrayLike
@@ -642,9 +638,9 @@ class UniversalCurves:
         """
         hp = np.atleast_1d(np.asarray(perigee_m, dtype=np.float64))
         ha = np.atleast_1d(np.asarray(apogee_m, dtype=np.float64))
-        label, tau = (np.array(v, dtype=np.float64) for v in self._label_tau(hp, ha))
+        start_label, start_tau = self._label_tau(hp, ha)
+        label, tau = start_label, start_tau  # replaced, not changed, by each Newton step
         y = np.log(np.maximum(_eccentricity(hp, ha), E_FLOOR))
-        start_label, start_tau = label.copy(), tau.copy()
         step = 1e-7
 
         def residuals(mu: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
