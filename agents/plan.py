@@ -25,9 +25,10 @@ that:
    per step); an observation that matches a
    track (same step, heights within `TRACK_HEIGHT_M`, delta-v left within
    `TRACK_DV_M_S`) gets that plan's burn; any other is planned anew from its
-   state. The env's state differs from the one decoded from the observation by
-   the curves' locate-and-read-back round trip (up to about 1.3 km of apogee),
-   which the tolerances cover.
+   state. The decoded state is the env's up to the observation's float32
+   rounding (`orbit_env.envs.task.decode`: some 0.1 m of apogee), so a track and
+   the env stay close; the tolerances are wide (they date from a decode that
+   was up to 1.3 km of apogee off), and the nearest track is taken.
 
 The search starts from the base's own plan and keeps only gains, so a plan
 earns at least the base's return in the task model from the decoded state. It
