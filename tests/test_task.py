@@ -184,3 +184,26 @@ def test_decode_recovers_the_env_s_point_on_the_curves():
     # Table A's point alone is further off than that: the check has teeth.
     _, tau_a = task.curves._label_tau(decoded.perigee_m[alive], decoded.apogee_m[alive])
     assert np.abs(np.expm1(tau_a) / np.expm1(states.tau[alive]) - 1.0).max() > 1e-4
+
+
+@pytest.mark.parametrize("n", [1, 7, 16, 1024, 4096])
+def test_batch_rows_begin_in_different_cache_sets_and_put_scatters_into_them(n):
+    """A batch's rows are staggered (an odd number of 64-byte lines apart), and put, copy and
+    pickling keep the satellites exactly, as a plain array's column assignment does."""
+    import pickle
+
+    state = BatchState(n)
+    row_bytes = state.data.strides[0]
+    assert row_bytes % 64 == 0 and (row_bytes // 64) % 2 == 1
+    rng = np.random.default_rng(n)
+    state.data[...] = rng.random(state.data.shape)
+    expected = np.array(state.data)
+    index = rng.permutation(n)[: max(1, n // 3)]
+    values = rng.random((state.data.shape[0], index.size))
+    state.put(index, values)
+    expected[:, index] = values
+    np.testing.assert_array_equal(state.data, expected)
+    for other in (state.copy(), pickle.loads(pickle.dumps(state))):
+        np.testing.assert_array_equal(other.data, expected)
+        assert other.data.strides == state.data.strides
+        assert not np.shares_memory(other.data, state.data)
