@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -159,6 +160,34 @@ def run_trial(config: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def capture_references(env_id: str, episodes: int, eval_seed: int, include_dp: bool = True) -> dict[str, Any]:
+    """The mean returns the capture is measured between: never burning, and the DP (None without it)."""
+    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, run_episodes
+
+    never = run_episodes(env_id, hand_coded_policies(env_id)["never"], episodes, eval_seed).returns.mean()
+    references: dict[str, Any] = {"never_return": float(never), "dp_return": None}
+    if include_dp:
+        references["dp_return"] = float(run_episodes(env_id, dp_policy(env_id), episodes, eval_seed).returns.mean())
+    return references
+
+
+def _progress_callback(tune: Any, total: int, say: Callable[[str], None]) -> Any:
+    """A Ray Tune callback that reports each finished trial through ``say`` (Tune itself is kept quiet)."""
+
+    class Progress(tune.Callback):  # type: ignore[misc, name-defined]
+        def on_trial_complete(self, iteration: int, trials: list[Any], trial: Any, **info: Any) -> None:
+            done = sum(t is trial or t.status == "TERMINATED" for t in trials)  # this one is not marked yet
+            result = trial.last_result or {}
+            capture = result.get("capture")
+            score = "" if capture is None else f", capture {100 * capture:.1f}%"
+            say(
+                f"trial {done}/{total} done: {result.get('algo')} seed {result.get('seed')}, "
+                f"mean return {result.get('mean_return', float('nan')):.2f}{score}, {result.get('wall_s', 0.0):.0f} s"
+            )
+
+    return Progress()
+
+
 def _ray_trainable(config: dict[str, Any]) -> None:
     from ray import tune
 
@@ -185,7 +214,7 @@ def sweep(
         ValueError: an unknown env or algorithm, one that does not fit the action space, counts below 1.
         ImportError: Ray is not installed (the ``cluster`` extra).
     """
-    from orbit_env.agents.evaluate import EVAL_SEED, check_env_id, dp_policy, hand_coded_policies, run_episodes
+    from orbit_env.agents.evaluate import EVAL_SEED, check_env_id
 
     check_env_id(env_id)
     from orbit_env.agents.evaluate import task_of
@@ -213,10 +242,7 @@ def sweep(
         references = json.loads(references_path.read_text())
     else:
         say("references: never" + (" and dp" if include_dp else ""))
-        never = run_episodes(env_id, hand_coded_policies(env_id)["never"], episodes, eval_seed).returns.mean()
-        references = {"never_return": float(never), "dp_return": None}
-        if include_dp:
-            references["dp_return"] = float(run_episodes(env_id, dp_policy(env_id), episodes, eval_seed).returns.mean())
+        references = capture_references(env_id, episodes, eval_seed, include_dp)
         references_path.write_text(json.dumps(references) + "\n")
     param_space = {
         "env_id": env_id,
@@ -240,7 +266,12 @@ def sweep(
             tuner = tune.Tuner(
                 trainable,
                 param_space=param_space,
-                run_config=tune.RunConfig(name="sweep", storage_path=str(storage), verbose=0),
+                run_config=tune.RunConfig(
+                    name="sweep",
+                    storage_path=str(storage),
+                    verbose=0,
+                    callbacks=[_progress_callback(tune, len(algos) * seeds, say)],
+                ),
             )
         grid = tuner.fit()
         cores = int(ray.cluster_resources().get("CPU", 0))
