@@ -50,6 +50,10 @@ SWEEP_NUM_ENVS = 16
 BOOTSTRAP_SAMPLES = 2000
 
 
+class SweepInterrupted(RuntimeError):
+    """The sweep stopped before every trial finished; the same call resumes it."""
+
+
 def iqm(values: NDArray[np.float64]) -> float:
     """Interquartile mean: the mean of the middle half (rliable's IQM; the mean for fewer than 4 values)."""
     x = np.sort(np.asarray(values, dtype=np.float64))
@@ -171,6 +175,26 @@ def capture_references(env_id: str, episodes: int, eval_seed: int, include_dp: b
     return references
 
 
+def finished_trials(results: list[Any], out: Path) -> list[dict[str, Any]]:
+    """The table's entries of Tune's results (each with ``.error`` and ``.metrics``).
+
+    Raises:
+        RuntimeError: a trial failed (its error).
+        SweepInterrupted: the sweep stopped (Ctrl-C, a time limit) before some trials
+            reported; Tune has kept the finished ones, and the same call resumes.
+    """
+    for result in results:
+        if result.error is not None:
+            raise RuntimeError(f"a trial failed: {result.error}")
+    unfinished = sum("mean_return" not in (result.metrics or {}) for result in results)
+    if unfinished:
+        raise SweepInterrupted(
+            f"the sweep stopped with {unfinished} of {len(results)} trials unfinished; "
+            f"run the same command again to resume it ({out})"
+        )
+    return [{key: r.metrics[key] for key in ("algo", "seed", "mean_return", "capture", "wall_s")} for r in results]
+
+
 def _progress_callback(tune: Any, total: int, say: Callable[[str], None]) -> Any:
     """A Ray Tune callback that reports each finished trial through ``say`` (Tune itself is kept quiet)."""
 
@@ -277,11 +301,7 @@ def sweep(
         cores = int(ray.cluster_resources().get("CPU", 0))
     finally:
         ray.shutdown()
-    trials = []
-    for result in grid:
-        if result.error is not None or not result.metrics or "mean_return" not in result.metrics:
-            raise RuntimeError(f"a trial failed: {result.error}")
-        trials.append({key: result.metrics[key] for key in ("algo", "seed", "mean_return", "capture", "wall_s")})
+    trials = finished_trials(list(grid), out)
     trials.sort(key=lambda t: (list(algos).index(t["algo"]), t["seed"]))
     output = {
         "env": env_id,

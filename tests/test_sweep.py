@@ -107,3 +107,18 @@ def test_the_shipped_baselines_are_of_the_current_model(env_id):
     now = capture_references(env_id, shipped["episodes"], shipped["eval_seed"])
     assert now["never_return"] == pytest.approx(shipped["never_return"], abs=1e-3)
     assert now["dp_return"] == pytest.approx(shipped["dp_return"], abs=1e-3)
+
+
+def test_a_stopped_sweep_says_how_to_resume_and_a_failed_trial_its_error(tmp_path):
+    from types import SimpleNamespace
+
+    from orbit_env.agents.sweep import SweepInterrupted, finished_trials
+
+    done = SimpleNamespace(error=None, metrics={"algo": "a2c", "seed": 0, "mean_return": 230.0, "capture": 0.0})
+    done.metrics["wall_s"] = 3.0
+    stopped = SimpleNamespace(error=None, metrics={})  # Tune's result of a trial cut off before it reported
+    assert finished_trials([done], tmp_path) == [done.metrics]
+    with pytest.raises(SweepInterrupted, match=r"1 of 2 trials unfinished; run the same command again"):
+        finished_trials([done, stopped], tmp_path)
+    with pytest.raises(RuntimeError, match="a trial failed: out of memory"):
+        finished_trials([done, SimpleNamespace(error="out of memory", metrics=None)], tmp_path)

@@ -92,20 +92,24 @@ def _certify(args: argparse.Namespace, say: Any) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from orbit_env.agents.sweep import format_table, sweep
+    from orbit_env.agents.sweep import SweepInterrupted, format_table, sweep
 
     algos = [a.strip() for a in args.algos.split(",") if a.strip()]
-    result = sweep(
-        args.env,
-        algos,
-        args.seeds,
-        args.timesteps,
-        args.out,
-        address=args.address,
-        episodes=args.episodes,
-        include_dp=not args.no_dp,
-        progress=lambda text: print(f"  {text} ...", file=sys.stderr),
-    )
+    try:
+        result = sweep(
+            args.env,
+            algos,
+            args.seeds,
+            args.timesteps,
+            args.out,
+            address=args.address,
+            episodes=args.episodes,
+            include_dp=not args.no_dp,
+            progress=lambda text: print(f"  {text} ...", file=sys.stderr),
+        )
+    except SweepInterrupted as stopped:
+        print(f"orbit-env sweep: {stopped}", file=sys.stderr)
+        return 1
     print(format_table(args.env, result["table"], args.timesteps))
     print(
         f"{len(result['trials'])} trials on {result['cores']} cores in {result['sweep_wall_s']:.0f} s; "
