@@ -399,15 +399,10 @@ class ContinuousFromDiscrete:
 
     def __init__(self, policy: Predictor, burn_sizes_m_s: tuple[float, ...], max_burn_m_s: float) -> None:
         self.policy = policy
-        self.max_burn_m_s = float(max_burn_m_s)
         self.actions = np.clip(np.asarray(burn_sizes_m_s) / max_burn_m_s, 0.0, 1.0).astype(np.float32)
 
     def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True):
-        """The discrete policy's burn as a Box action (a DP's own burn where it has one: see `DPPolicy.burns_m_s`)."""
-        if hasattr(self.policy, "burns_m_s"):
-            burns = np.asarray(self.policy.burns_m_s(observation))
-            actions = np.clip(burns / self.max_burn_m_s, 0.0, 1.0).astype(np.float32)[:, None]
-            return (actions[0] if np.ndim(observation) == 1 else actions), state
+        """The discrete policy's burn as a Box action."""
         index, state = self.policy.predict(observation, state, episode_start, deterministic)
         return self.actions[np.asarray(index)][..., None], state
 

@@ -117,6 +117,8 @@ class PlanPolicy:
         self.solution = base.solution
         self.config = base.config
         self.task = self.solution._model.task
+        # The task the plans act in: the same satellite, with the Box action (`Task.encode`).
+        self._acting = task_model.Task(self.config, self.task.density, continuous=True)
         self.window = int(window)
         self.steps_m_s = tuple(float(h) for h in steps_m_s)
         self.progress = progress
@@ -148,8 +150,7 @@ class PlanPolicy:
         deterministic: bool = True,
     ) -> tuple[Any, Any]:
         """Box actions a = burn / max burn for one observation (7,) or a batch (n, 7); SB3's signature."""
-        burns = self.burns_m_s(observation)
-        actions = np.clip(burns / self.config.max_burn_m_s, 0.0, 1.0).astype(np.float32)[:, None]
+        actions = self._acting.encode(self.burns_m_s(observation))
         return (actions[0] if np.ndim(observation) == 1 else actions), state
 
     def _lookup(self, features: FloatArray, steps: NDArray[np.intp]) -> tuple[NDArray[np.bool_], FloatArray]:
