@@ -11,12 +11,16 @@ re-entry date minus the start (benchmarks/reentry_cases.csv), never the code's o
   refinements (0.1-0.5% on lifetimes, docs section 3) pass;
 * over all cases, the median |error| and its 90th percentile stay below ceilings set the
   same way. The issue's goal (median 10%, 90th percentile 25%) is NOT met: measured
-  11.5% and 46%, see the docs for the misses and their likely reasons.
+  11.5% and 46%, see the docs for the misses and their likely reasons;
+* the 90% band of ``--uncertainty`` (`band`): the observed life inside it for every case
+  but those in OUTSIDE_BAND (12 of 15 when the docs were written), and `band` is the band
+  the command line's Monte Carlo reports (GOCE, 1000 samples).
 """
 
 from __future__ import annotations
 
 import importlib.util
+import json
 import sys
 from pathlib import Path
 
@@ -46,6 +50,9 @@ KNOWN_MISSES = {
     "San Marco 4": 0.40,  # +26.5%
 }
 WITHIN = 0.25
+#: The cases whose observed life lies outside the 90% band (measured: Sputnik 1 91.7 d against
+#: 125.9-231.9 d, San Marco 2 176.1 against 200.1-329.4, San Marco 3 218.2 against 243.4-407.7).
+OUTSIDE_BAND = {"Sputnik 1", "San Marco 2", "San Marco 3"}
 #: Ceilings over all cases (measured: median 11.5%, 90th percentile 46.0%).
 MEDIAN_CEILING = 0.15
 P90_CEILING = 0.55
@@ -54,8 +61,10 @@ P90_CEILING = 0.55
 QUICK = ("Sputnik 1", "San Marco 1", "Starshine 2", "GOCE")
 
 
-def check(rows):
+def check(rows, band=False):
     for row in rows:
+        if band:
+            assert row.inside_band == (row.name not in OUTSIDE_BAND), (row.name, row.observed_days, row.band_days)
         error = row.model_days / row.observed_days - 1.0
         if row.name in KNOWN_MISSES:
             assert WITHIN < abs(error) <= KNOWN_MISSES[row.name], (row.name, error)
@@ -83,10 +92,28 @@ def test_quick_cases_against_their_observed_lives(validation):
     check(validation.run([c for c in validation.CASES if c.name in QUICK], first_choice=False))
 
 
+def test_the_band_is_the_command_lines_monte_carlo(validation, capsys):
+    # GOCE (20 days): the band's two propagations against --uncertainty's 1000 samples. The
+    # samples' 5th and 95th percentiles scatter by about 1.2% (standard error of a 5% quantile of
+    # 1000 log-normal samples with sigma 0.18), so 4% is over three standard errors.
+    from orbit_env.cli import main
+
+    activity = validation.load_record()
+    goce = next(c for c in validation.CASES if c.name == "GOCE")
+    cd = validation.drag_coefficient(goce, activity)[0]
+    low, high = validation.band(goce, activity, cd)
+    argv = ["lifetime", "--perigee", "224", "--apogee", "224", "--mass", "1100", "--area", "1.1", "--cx", str(cd)]
+    argv += ["--epoch", goce.start, "--inclination", "96.7", "--node-local-time", "18", "--rotating-atmosphere"]
+    assert main([*argv, "--uncertainty", "--json", "--no-progress"]) == 0
+    percentiles = json.loads(capsys.readouterr().out)["days_percentiles"]
+    assert percentiles["5"] == pytest.approx(low, rel=0.04)
+    assert percentiles["95"] == pytest.approx(high, rel=0.04)
+
+
 @pytest.mark.slow
 def test_all_cases_against_their_observed_lives(validation):
-    rows = validation.run(validation.CASES, first_choice=False)
-    check(rows)
+    rows = validation.run(validation.CASES, first_choice=False, with_band=True)
+    check(rows, band=True)
     median, p90, within = validation.summary([row.model_days / row.observed_days - 1.0 for row in rows])
     assert median <= MEDIAN_CEILING
     assert p90 <= P90_CEILING
