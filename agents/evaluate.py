@@ -493,8 +493,9 @@ def dp_policy(env_id: str, lookahead: int = 1, rollout: bool = False) -> Predict
 #: steps is played before the base policy (single burns leave starts beaten by up to 0.17 day).
 ROLLOUT_DEPTH = 2
 #: Spacing of the burn sizes the DP of the continuous variant chooses from [m/s]. Measured on the
-#: 1000 evaluation episodes (seed 12345, grid (192, 1, 1)), realized mean return: 278.16 (20 m/s,
-#: solve 12 s, 1.1 GB), 278.41 (10 m/s, 60 s, 2.8 GB), 278.57 (5 m/s, 186 s, 7.3 GB); docs/dp.md.
+#: 1000 evaluation episodes (seed 12345, grid (192, 1, 1)), realized mean return: 278.05 (20 m/s,
+#: solve and episodes 23 s, 0.5 GB), 278.21 (10 m/s, 54 s, 1.9 GB), 278.28 (5 m/s, 229 s, 6.6 GB);
+#: docs/dp.md.
 CONTINUOUS_DP_STEP_M_S = 10.0
 
 
