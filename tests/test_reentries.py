@@ -102,8 +102,10 @@ def test_the_band_is_the_command_lines_monte_carlo(validation, capsys):
     goce = next(c for c in validation.CASES if c.name == "GOCE")
     cd = validation.drag_coefficient(goce, activity)[0]
     low, high = validation.band(goce, activity, cd)
-    argv = ["lifetime", "--perigee", "224", "--apogee", "224", "--mass", "1100", "--area", "1.1", "--cx", str(cd)]
-    argv += ["--epoch", goce.start, "--inclination", "96.7", "--node-local-time", "18", "--rotating-atmosphere"]
+    argv = ["lifetime", "--perigee", str(goce.perigee_km), "--apogee", str(goce.apogee_km), "--cx", str(cd)]
+    argv += ["--mass", str(goce.mass_kg), "--area", str(goce.shape.reference_area_m2), "--epoch", goce.start]
+    argv += ["--inclination", str(goce.inclination_deg), "--node-local-time", str(goce.node_local_time_h)]
+    argv += ["--rotating-atmosphere"]  # heights: the command line's default, above the equatorial radius
     assert main([*argv, "--uncertainty", "--json", "--no-progress"]) == 0
     percentiles = json.loads(capsys.readouterr().out)["days_percentiles"]
     assert percentiles["5"] == pytest.approx(low, rel=0.04)
