@@ -16,8 +16,8 @@ Three sources, independent, each a log-normal factor (sigma in the natural log):
   the density held for the whole life. A lifetime integrates the density over months or
   years, so the spread that matters is that of the model's slowly varying bias: Bruinsma &
   Boniface (2021, "The operational and research DTM-2020 thermosphere models", J. Space
-  Weather Space Clim. 11, 47, Table 3) give the standard deviation of the yearly mean ratio
-  of observed to NRLMSISE-00 density as 4.9-21.5% over eleven data sets (CHAMP 12.9%, GRACE
+  Weather Space Clim. 11, 47, Table 3) give the standard deviation of the yearly mean density
+  ratio between the data and NRLMSISE-00 as 4.9-21.5% over eleven data sets (CHAMP 12.9%, GRACE
   16.7%, GOCE 4.9%, orbit-derived densities at 250 km 10-11%, HASDM at 400 km 18.1%). 0.15
   sits in that range; for NRLMSIS 2.0 (Emmert et al. 2021, Earth and Space Science) we had
   no such table at hand. The hindcasts of ``docs/validation-modern.md`` (section 5) count
