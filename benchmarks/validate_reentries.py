@@ -323,6 +323,9 @@ def plot(rows: list[Row], path: str) -> None:
     order = sorted(rows, key=lambda r: r.error)
     for number, r in enumerate(rows, start=1):
         color = "tab:red" if starts[r.name] < unix_days("1990-01-01") else "tab:blue"
+        if not math.isnan(r.band_days[0]):  # the 90% band of --uncertainty
+            below, above = r.model_days - r.band_days[0], r.band_days[1] - r.model_days
+            ax.errorbar(r.observed_days, r.model_days, yerr=[[below], [above]], color=color, lw=0.8, capsize=2)
         ax.plot(r.observed_days, r.model_days, "o", color=color, ms=5)
         ax.annotate(
             str(number), (r.observed_days, r.model_days), fontsize=7, xytext=(4, -8), textcoords="offset points"
@@ -330,6 +333,10 @@ def plot(rows: list[Row], path: str) -> None:
     ax.plot([], [], "o", color="tab:red", label="launched 1957-1974")
     ax.plot([], [], "o", color="tab:blue", label="launched 1995-2013")
     ax.fill_between([], [], [], color="0.88", label="+-25%")
+    if not any(math.isnan(r.band_days[0]) for r in rows):
+        inside = sum(r.inside_band for r in rows)
+        label = f"90% band of --uncertainty ({inside} of {len(rows)} hold the observed)"
+        ax.errorbar([], [], yerr=[], color="0.3", lw=0.8, label=label)
     median, p90, within = summary([r.error for r in rows])
     ax.set(xscale="log", yscale="log", xlim=lim, ylim=lim, xlabel="observed lifetime [days]",
            ylabel="predicted lifetime [days]")  # fmt: skip
