@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from orbit_env.analysis.lifetime import Satellite, lifetime
-from orbit_env.analysis.shapes import Shape, drag_at_start, flown_nose_first, sphere
+from orbit_env.analysis.shapes import ACCOMMODATION, Shape, drag_at_start, flown_nose_first, sphere
 from orbit_env.analysis.uncertainty import DENSITY_MODEL_SIGMA, DRAG_COEFFICIENT_SIGMA
 from orbit_env.decay.solar import SolarActivity, unix_days
 from orbit_env.decay.solar_record import load_record
@@ -123,7 +123,9 @@ def observed_days(case: Case) -> float:
     return unix_days(case.reentry) - unix_days(case.start)
 
 
-def drag_coefficient(case: Case, activity: SolarActivity, gas_height: str = "perigee") -> tuple[float, float, float]:
+def drag_coefficient(
+    case: Case, activity: SolarActivity, gas_height: str = "perigee", accommodation: float = ACCOMMODATION
+) -> tuple[float, float, float]:
     """The model's drag coefficient on the reference area, density-weighted over the orbit; also mean S and T [K].
 
     NRLMSIS at the start (the orbit's latitudes and local times at the initial perigee, or at
@@ -138,6 +140,7 @@ def drag_coefficient(case: Case, activity: SolarActivity, gas_height: str = "per
         tuple(float(x) for x in activity.indices(unix_days(case.start))),
         case.start,
         ascending_node_local_time_h=case.node_local_time_h,
+        accommodation=accommodation,
     )
     return gas.drag_coefficient, gas.speed_ratio, gas.temperature_k
 
@@ -205,13 +208,15 @@ def band(case: Case, activity: SolarActivity, cx: float) -> tuple[float, float]:
     return predict(case, activity, cx, density_scale=factor), predict(case, activity, cx, density_scale=1.0 / factor)
 
 
-def run(cases: list[Case] = CASES, first_choice: bool = True, with_band: bool = False) -> list[Row]:
+def run(
+    cases: list[Case] = CASES, first_choice: bool = True, with_band: bool = False, accommodation: float = ACCOMMODATION
+) -> list[Row]:
     """Predict every case (``first_choice=False`` skips the c_x 2.2 column, then NaN; ``with_band`` adds the band)."""
     activity = load_record()
     rows = []
     for case in cases:
         begin = time.perf_counter()
-        cd, s, temperature = drag_coefficient(case, activity)
+        cd, s, temperature = drag_coefficient(case, activity, accommodation=accommodation)
         model = predict(case, activity, cd)
         seconds = time.perf_counter() - begin
         first = predict(case, activity, FIRST_CHOICE_CX) if first_choice else math.nan
@@ -232,10 +237,19 @@ def main() -> None:
     parser.add_argument("--plot", help="write predicted against observed to this PNG")
     parser.add_argument("--sensitivity", action="store_true", help="also: C_D +5%%, heights -5/+5 km, gas height")
     parser.add_argument("--trend", action="store_true", help="also: the secular density trend (TREND_PER_DECADE)")
+    parser.add_argument(
+        "--accommodation",
+        type=float,
+        default=ACCOMMODATION,
+        help="the drag model's energy accommodation (default 1: full)",
+    )
     parser.add_argument("--band", action="store_true", help="also the 90%% band of --uncertainty (2 lifetimes a case)")
     args = parser.parse_args()
     begin = time.perf_counter()
-    rows = run(with_band=args.band)
+    if not 0.0 < args.accommodation <= 1.0:
+        parser.error(f"--accommodation must be in (0, 1], got {args.accommodation}")
+    print(f"drag model: energy accommodation {args.accommodation:g}")
+    rows = run(with_band=args.band, accommodation=args.accommodation)
     total = time.perf_counter() - begin
     header = f"{'case':12} {'observed d':>10} {'c_x 2.2 d':>10} {'err':>7} {'model C_D':>9} {'S':>5} {'T K':>5}"
     print(header + f" {'model d':>9} {'err':>7} {'s':>5}" + ("   90% band d" if args.band else ""))

@@ -75,6 +75,17 @@ def test_full_accommodation_reemits_at_the_wall_temperature():
     assert reemission_speed_ratio(7.5, 0.3, 0.0) == pytest.approx(math.sqrt(0.5), rel=1e-14)  # specular energy
 
 
+def test_shapes_pass_the_accommodation_on():
+    # The analysis layer's shapes with a partial accommodation: the physics layer's formula, and more
+    # drag than full accommodation (the molecules keep more of their incident energy and leave faster).
+    from orbit_env.analysis.shapes import flown_nose_first, sphere
+
+    ball, box = sphere(0.5), flown_nose_first(1.0, 10.0)
+    assert ball.drag_coefficient(7.5, 0.3, 0.9) == pytest.approx(sphere_drag_coefficient(7.5, 0.3, 0.9), rel=1e-14)
+    assert ball.drag_coefficient(7.5, 0.3, 0.9) > ball.drag_coefficient(7.5, 0.3)
+    assert box.drag_coefficient(7.5, 0.3, 0.9) > box.drag_coefficient(7.5, 0.3)
+
+
 def test_tumbling_convex_body_equals_its_orientation_average():
     # A cube tumbling at random: average the six faces' drag over random flow directions.
     rng = np.random.default_rng(5)

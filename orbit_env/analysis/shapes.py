@@ -46,13 +46,15 @@ class Shape:
     panel_areas_m2: tuple[float, ...] = ()
     panel_cos_incidence: tuple[float, ...] = ()
 
-    def drag_coefficient(self, s: np.ndarray, wall_to_gas: np.ndarray) -> np.ndarray:
+    def drag_coefficient(
+        self, s: np.ndarray, wall_to_gas: np.ndarray, accommodation: float = ACCOMMODATION
+    ) -> np.ndarray:
         """Drag coefficient on the reference area for speed ratios ``s`` and T_w / T (arrays alike)."""
         if self.sphere:
-            return sphere_drag_coefficient(s, wall_to_gas, ACCOMMODATION)
+            return sphere_drag_coefficient(s, wall_to_gas, accommodation)
         areas = np.array(self.panel_areas_m2)
         gamma = np.array(self.panel_cos_incidence)
-        return panel_drag_area_m2(areas, gamma, s, wall_to_gas, ACCOMMODATION) / self.reference_area_m2
+        return panel_drag_area_m2(areas, gamma, s, wall_to_gas, accommodation) / self.reference_area_m2
 
 
 def sphere(diameter_m: float) -> Shape:
@@ -86,6 +88,7 @@ def drag_at_start(
     *,
     ascending_node_local_time_h: float | None = None,
     rotating_atmosphere: bool = True,
+    accommodation: float = ACCOMMODATION,
 ) -> DragAtStart:
     """The free-molecular drag coefficient of ``shape`` at the mean height ``height_m`` (above the sphere).
 
@@ -97,6 +100,7 @@ def drag_at_start(
         date: ISO date and time (None: `DEFAULT_GAS_DATE`).
         ascending_node_local_time_h: Sun-synchronous orbits: the node's local time.
         rotating_atmosphere: Whether the speed is taken against co-rotating air.
+        accommodation: Energy accommodation coefficient, 0-1 (default: full, Sentman's case).
     """
     msis = require_pymsis()
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h)
@@ -122,6 +126,6 @@ def drag_at_start(
         # The air's eastward speed projected on the track averages omega r cos i.
         speed -= EARTH_ROTATION_RAD_S * radius_m * math.cos(math.radians(inclination_deg))
     s = speed_ratio(speed, temperature, molecular_mass)
-    cd = shape.drag_coefficient(s, WALL_TEMPERATURE_K / temperature)
+    cd = shape.drag_coefficient(s, WALL_TEMPERATURE_K / temperature, accommodation)
     weight = rho / rho.sum()
     return DragAtStart(float(np.sum(weight * cd)), float(np.sum(weight * s)), float(np.sum(weight * temperature)))
