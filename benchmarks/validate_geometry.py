@@ -7,7 +7,9 @@ The decay core sees NRLMSIS as one density-against-height profile, averaged over
 latitudes and local times an orbit visits (`orbit_env.physics.atmosphere.msis`): right
 for a circular orbit, and for an eccentric one only if its perigee visits them all evenly
 over the life. This check drops that assumption. It is independent of the package's decay
-code (it shares only the solar record, the constants and the case list):
+code: it shares with the package only the solar record, the constants, the case list and
+geometry that is not under test here (elements from heights, J2's secular rates, the height
+above WGS84):
 
 * the orbit is (a, e, i, node, argument of perigee) at a date; each step averages the drag
   acceleration -1/2 B rho |v_rel| v_rel over one revolution, at ``POINTS`` points evenly
@@ -33,19 +35,15 @@ import math
 import time
 
 import numpy as np
+from sgp4.propagation import gstime
 from validate_reentries import CASES, EQUATORIAL_OFFSET_KM, Case, drag_coefficient, observed_days, predict
 
-from orbit_env.constants import (
-    EARTH_EQUATORIAL_RADIUS_M,
-    EARTH_RADIUS_M,
-    EARTH_ROTATION_RAD_S,
-    J2_EARTH,
-    MU_EARTH_M3_S2,
-    REENTRY_ALTITUDE_M,
-)
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M
 from orbit_env.decay.solar import SolarActivity, unix_days
 from orbit_env.decay.solar_record import load_record
-from orbit_env.physics.atmosphere.msis import WGS84_FLATTENING, require_pymsis
+from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, require_pymsis
+from orbit_env.physics.oblateness import node_rate_rad_per_day, perigee_rate_rad_per_day
+from orbit_env.physics.orbit import elements_from_heights, semi_major_axis_m
 
 #: Points per revolution, evenly spaced in eccentric anomaly.
 POINTS = 720
@@ -57,8 +55,8 @@ _EPOCH = np.datetime64("1970-01-01T00:00", "s")
 
 
 def sidereal_angle_rad(days: float) -> float:
-    """Greenwich mean sidereal angle at unix day ``days`` (IAU 1982, to 0.1 s: plenty for longitudes)."""
-    return math.radians((280.46061837 + 360.98564736629 * (days - 10957.5)) % 360.0)
+    """Greenwich mean sidereal angle at unix day ``days`` (IAU 1982, sgp4's ``gstime``; UT1 taken as UTC)."""
+    return float(gstime(days + 2440587.5))
 
 
 def sun_right_ascension_rad(days: float) -> float:
@@ -96,7 +94,7 @@ def mean_rates(
     v = rotation @ perifocal_v
     radius = np.linalg.norm(r, axis=0)
     latitude = np.arcsin(r[2] / radius)
-    height_km = (radius - EARTH_EQUATORIAL_RADIUS_M * (1.0 - WGS84_FLATTENING * np.sin(latitude) ** 2)) / 1e3
+    height_km = geodetic_altitude_m(radius - EARTH_RADIUS_M, np.degrees(latitude)) / 1e3
     longitude = np.degrees(np.mod(np.arctan2(r[1], r[0]) - sidereal_angle_rad(days), 2.0 * np.pi))
     f107, f107a, ap = (float(x) for x in activity.indices(days))
     date = _EPOCH + np.timedelta64(round(days * 86400.0), "s")
@@ -123,19 +121,19 @@ def mean_rates(
 
 
 def j2_rates_rad_s(a_m: float, e: float, i: float) -> tuple[float, float]:
-    """Secular d(node)/dt and d(argument of perigee)/dt by J2 [rad/s]."""
-    n = math.sqrt(MU_EARTH_M3_S2 / a_m**3)
-    factor = 1.5 * n * J2_EARTH * (EARTH_EQUATORIAL_RADIUS_M / (a_m * (1.0 - e * e))) ** 2
-    return -factor * math.cos(i), 0.5 * factor * (5.0 * math.cos(i) ** 2 - 1.0)
+    """Secular d(node)/dt and d(argument of perigee)/dt by J2 [rad/s] (`orbit_env.physics.oblateness`)."""
+    p = a_m * (1.0 - e * e)
+    return float(node_rate_rad_per_day(p, e, i)) / 86400.0, float(perigee_rate_rad_per_day(p, e, i)) / 86400.0
 
 
 def resolved_lifetime_days(
     case: Case, b_m2_kg: float, perigee_local_time_h: float, perigee_rad: float, activity: SolarActivity
 ) -> float:
     """Days to re-entry from the case's start with the perigee at that local time and argument."""
-    rp = EARTH_RADIUS_M + (case.perigee_km + EQUATORIAL_OFFSET_KM) * 1e3
-    ra = EARTH_RADIUS_M + (case.apogee_km + EQUATORIAL_OFFSET_KM) * 1e3
-    a, e = 0.5 * (rp + ra), (ra - rp) / (ra + rp)
+    p, ecc = elements_from_heights(
+        (case.perigee_km + EQUATORIAL_OFFSET_KM) * 1e3, (case.apogee_km + EQUATORIAL_OFFSET_KM) * 1e3
+    )
+    a, e = float(semi_major_axis_m(p, ecc)), float(ecc)
     i = math.radians(case.inclination_deg)
     days = start = unix_days(case.start)
     # The node that puts the perigee's right ascension at that local time.

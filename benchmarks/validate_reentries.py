@@ -275,7 +275,7 @@ def main() -> None:
     if args.plot:
         plot(rows, args.plot)
     if args.sensitivity:
-        sensitivity(rows)
+        sensitivity(rows, args.accommodation)
     if args.trend:
         trend(rows)
 
@@ -292,7 +292,7 @@ def trend(rows: list[Row]) -> None:
     print(f"with the trend: median |error| {median:.1%}, 90th percentile {p90:.1%}, {within} within +-25%")
 
 
-def sensitivity(rows: list[Row]) -> None:
+def sensitivity(rows: list[Row], accommodation: float = ACCOMMODATION) -> None:
     """How far each prediction moves with its most uncertain inputs (C_D, the heights, the gas's height)."""
     activity = load_record()
     print(
@@ -300,7 +300,7 @@ def sensitivity(rows: list[Row]) -> None:
         "   (predicted / observed - 1 with that change)"
     )
     for case, row in zip(CASES, rows, strict=True):
-        mean_cd = drag_coefficient(case, activity, gas_height="mean")[0]
+        mean_cd = drag_coefficient(case, activity, gas_height="mean", accommodation=accommodation)[0]
         changes = [
             predict(case, activity, row.drag_coefficient * 1.05),
             predict(case, activity, row.drag_coefficient, -5.0),
@@ -312,12 +312,12 @@ def sensitivity(rows: list[Row]) -> None:
     for name, mass in (("GOCE", 1040.0), ("GRACE-2", 432.0)):
         case = next(c for c in CASES if c.name == name)
         lighter = replace(case, mass_kg=mass)
-        cd = drag_coefficient(lighter, activity)[0]
+        cd = drag_coefficient(lighter, activity, accommodation=accommodation)[0]
         print(f"{name} at {mass:g} kg: {predict(lighter, activity, cd) / observed_days(case) - 1:+.1%}")
     goce = next(c for c in CASES if c.name == "GOCE")
     for parallel in (27.0, 33.0):
         shaped = replace(goce, shape=flown_nose_first(1.1, parallel))
-        cd = drag_coefficient(shaped, activity)[0]
+        cd = drag_coefficient(shaped, activity, accommodation=accommodation)[0]
         error = predict(shaped, activity, cd) / observed_days(goce) - 1
         print(f"GOCE with {parallel:g} m^2 parallel: C_D {cd:.2f}, {error:+.1%}")
 

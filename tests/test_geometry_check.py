@@ -2,7 +2,7 @@
 
 The check integrates the revolution-averaged Gauss equations with NRLMSIS at each point's
 real latitude, longitude, height above WGS84 and date, and the full co-rotating-air drag
-vector; it shares with the package only the solar record, the constants and the case list.
+vector; it shares none of the package's decay code (only the solar record, constants, case list and geometry).
 San Marco 2 (219 x 741 km at 2.9 deg, 1967) is the largest equatorial miss of the
 hindcasts: whether the averaged profile, rather than the atmosphere or the inputs, makes its
 prediction long is what this pins. Measured: resolved 258.2-260.2 d over four starting local
