@@ -7,10 +7,12 @@ reset options, rendering. Its class docstring is the user's manual.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, ClassVar
 
 import gymnasium as gym
 import numpy as np
+from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
@@ -92,9 +94,15 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     Termination: re-entry, perigee at 100 km (the paper's end of integration).
     Truncation: after ``horizon_steps`` steps (365), by the environment itself:
     ``horizon_steps`` alone sets the truncation and the mission clock, so the ids
-    are registered without ``max_episode_steps``. (A ``max_episode_steps`` given to
-    ``gymnasium.make`` adds Gymnasium's ``TimeLimit`` outside the environment,
-    which cannot see it: pass ``horizon_steps`` instead.)
+    are registered without ``max_episode_steps`` and ``gymnasium.make`` adds no
+    ``TimeLimit``. ``env.spec.max_episode_steps`` reports the horizon all the same:
+    365, or the ``horizon_steps`` given (``gymnasium.make(id, horizon_steps=100)``
+    says 100), the length of a mission that does not re-enter. An environment made
+    again from its spec (``gymnasium.make(env.spec)``, as ``check_env`` does) gets a
+    ``TimeLimit`` at that same step, which changes nothing. (A different
+    ``max_episode_steps`` given to ``gymnasium.make`` adds Gymnasium's ``TimeLimit``
+    outside the environment, which cannot see it, and the spec then reports that
+    limit: pass ``horizon_steps`` instead.)
 
     ## Arguments
 
@@ -153,6 +161,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 8}
+    _spec: EnvSpec | None = None
 
     def __init__(
         self,
@@ -178,6 +187,19 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         self._track: list[tuple[float, float, float]] = []  # (perigee, apogee, burn) for render()
         self._last_burn_m_s = 0.0
         self._renderer: Any = None
+
+    @property
+    def spec(self) -> EnvSpec | None:
+        """Gymnasium's spec of the environment, ``max_episode_steps`` the horizon (see Episode End)."""
+        return self._spec
+
+    @spec.setter
+    def spec(self, spec: EnvSpec | None) -> None:
+        # gymnasium.make sets a spec without max_episode_steps (no TimeLimit: the env truncates
+        # itself); readers of the spec (wrappers, researchers) still learn the episode's length.
+        if spec is not None and spec.max_episode_steps is None:
+            spec = dataclasses.replace(spec, max_episode_steps=self.config.horizon_steps)
+        self._spec = spec
 
     # The universal curves are not an attribute: universal_curves() is the process's
     # one cached table, so a pickled env carries only its own state. Neither does it
