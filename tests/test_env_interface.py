@@ -8,6 +8,7 @@ without a display, outcome keys in ``info``).
 from __future__ import annotations
 
 import gymnasium as gym
+import numpy as np
 import pytest
 from gymnasium.wrappers import TimeLimit
 
@@ -50,3 +51,33 @@ def test_the_spec_reports_the_horizon_without_a_second_time_limit(env_id):
     assert again.spec.max_episode_steps == 10 and again.unwrapped.config.horizon_steps == 10
     again.reset(seed=0, options=OUTLIVES)
     assert [again.step(again.action_space.sample())[3] for _ in range(10)] == [False] * 9 + [True]
+
+
+# --------------------------------------------------------------------------------------
+# Continuous actions outside [-1, 1] are clipped, as LunarLander's; NaN is refused
+# --------------------------------------------------------------------------------------
+
+
+def test_continuous_actions_outside_the_box_are_clipped_and_nan_refused():
+    start = {"perigee_km": 300.0, "apogee_km": 600.0}
+    for outside, inside in ((1.5, 1.0), (7.0, 1.0), (-3.0, -1.0)):
+        clipped, plain = gym.make("OrbitRaisingContinuous-v0"), gym.make("OrbitRaisingContinuous-v0")
+        clipped.reset(seed=0, options=start)
+        plain.reset(seed=0, options=start)
+        a = clipped.step(np.array([outside], dtype=np.float32))
+        b = plain.step(np.array([inside], dtype=np.float32))
+        np.testing.assert_array_equal(a[0], b[0])
+        assert a[1:] == b[1:]
+    assert a[4]["burn_m_s"] == 0.0  # -3 clips to -1: a coast
+    assert b[4]["burn_m_s"] == 0.0
+    env = gym.make("OrbitRaisingContinuous-v0").unwrapped
+    env.reset(seed=0, options=start)
+    assert env.step(2.0)[4]["burn_m_s"] == 100.0  # a plain number clips too
+    with pytest.raises(ValueError, match=r"action=array\(\[nan\]"):
+        env.step(np.array([np.nan], dtype=np.float32))
+    vec = gym.make_vec("OrbitRaisingContinuous-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    vec.reset(seed=0, options=start)
+    *_, info = vec.step(np.array([[2.0], [-5.0], [0.5]]))
+    np.testing.assert_array_equal(info["burn_m_s"], [100.0, 0.0, 50.0])
+    with pytest.raises(ValueError, match=r"action nan is invalid; allowed: numbers, not NaN \(clipped to \[-1, 1\]\)"):
+        vec.step(np.array([[0.0], [np.nan], [0.0]]))

@@ -646,9 +646,8 @@ def test_random_configs_keep_the_vector_state_physical(config, density, continuo
         ("OrbitRaising-v0", -1, r"action=-1 is invalid"),
         ("OrbitRaising-v0", 1.0, r"action=1.0 is invalid"),
         ("OrbitRaising-v0", True, r"action=True is invalid"),
-        ("OrbitRaisingContinuous-v0", np.array([1.5], dtype=np.float32), r"allowed: one number in \[-1, 1\]"),
-        ("OrbitRaisingContinuous-v0", np.array([np.nan], dtype=np.float32), r"allowed: one number in \[-1, 1\]"),
-        ("OrbitRaisingContinuous-v0", np.zeros(2, dtype=np.float32), r"allowed: one number in \[-1, 1\]"),
+        ("OrbitRaisingContinuous-v0", np.array([np.nan], dtype=np.float32), r"allowed: one number, not NaN"),
+        ("OrbitRaisingContinuous-v0", np.zeros(2, dtype=np.float32), r"allowed: one number, not NaN"),
     ],
 )
 def test_invalid_actions_raise_value_errors(env_id, action, message):
@@ -667,8 +666,8 @@ def test_invalid_vector_actions_raise_value_errors():
         env.step(np.array([0.0, 1.0, 1.0]))
     continuous = make_vec("OrbitRaisingContinuous-v0", 2)
     continuous.reset(seed=0)
-    with pytest.raises(ValueError, match=r"action 2.0 is invalid; allowed: numbers in \[-1, 1\]"):
-        continuous.step(np.array([[0.0], [2.0]]))
+    with pytest.raises(ValueError, match=r"action nan is invalid; allowed: numbers, not NaN"):
+        continuous.step(np.array([[0.0], [np.nan]]))
 
 
 @pytest.mark.parametrize(

@@ -45,11 +45,11 @@ def test_uniform_box_samples_what_box_samples(low, high, shape):
 
 def test_continuous_action_fast_path_equals_the_general_path():
     task = Task(continuous=True)
-    for value in (-1.0, -0.3, 0.0, 0.25, 0.999, 1.0):
+    for value in (-2.0, -1.0, -0.3, 0.0, 0.25, 0.999, 1.0, 1.5):
         fast = task.requested_dv(np.array([value], dtype=np.float32))
         general = task.requested_dv(np.array(value, dtype=np.float32))  # a 0-d array: the general path
-        assert fast == general == task.config.max_burn_m_s * max(float(np.float32(value)), 0.0)
-    for bad in (np.array([np.nan], dtype=np.float32), np.array([1.5], dtype=np.float32)):
+        assert fast == general == task.config.max_burn_m_s * min(max(float(np.float32(value)), 0.0), 1.0)
+    for bad in (np.array([np.nan], dtype=np.float32), np.array(np.nan, dtype=np.float32)):
         with pytest.raises(ValueError, match="action"):
             task.requested_dv(bad)
 

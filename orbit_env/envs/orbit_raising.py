@@ -44,7 +44,9 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``OrbitRaising-v0``: ``Discrete(4)``, the index of a burn in
     ``config.burn_sizes_m_s`` = (0, 10, 30, 100) m/s; 0 coasts.
     ``OrbitRaisingContinuous-v0``: ``Box(-1, 1, (1,))``; a burn of
-    ``max_burn_m_s * max(a, 0)`` (100 m/s at +1), so half the range coasts.
+    ``max_burn_m_s * max(a, 0)`` (100 m/s at +1), so half the range coasts. An
+    action outside [-1, 1] is clipped to it, as Gymnasium's LunarLander clips (2.0
+    burns 100 m/s, -3.0 coasts); a NaN action is a ``ValueError``.
     Every burn is cut to the propellant on board and to the 4000 km apogee where
     the universal curves end; the burn made is ``info["burn_m_s"]``.
 

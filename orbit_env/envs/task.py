@@ -193,7 +193,11 @@ class Task:
         return spaces.Discrete(len(self.config.burn_sizes_m_s))
 
     def requested_dv(self, action: Any) -> float:
-        """The burn [m/s] one action asks for; ValueError for an action outside the action space."""
+        """The burn [m/s] one action asks for; ValueError for an action outside the action space.
+
+        A continuous action outside [-1, 1] is clipped to it, as Gymnasium's LunarLander
+        clips; NaN is a ValueError.
+        """
         sizes = self.config.burn_sizes_m_s
         if not self.continuous:
             if isinstance(action, (int, np.integer)) and not isinstance(action, bool):
@@ -206,15 +210,18 @@ class Task:
             )
         if isinstance(action, np.ndarray) and action.shape == (1,) and action.dtype.kind == "f":
             one = action.item()  # the action space's own form, without numpy calls on a 1-element array
-            if -1.0 <= one <= 1.0:  # False for NaN
-                return self.config.max_burn_m_s * max(one, 0.0)
+            if one == one:  # False for NaN
+                return self.config.max_burn_m_s * min(max(one, 0.0), 1.0)
         value = np.asarray(action, dtype=np.float64) if not isinstance(action, (str, bytes)) else np.array(np.nan)
-        if value.shape not in ((), (1,)) or not (np.isfinite(value).all() and (np.abs(value) <= 1.0).all()):
-            raise ValueError(f"action={action!r} is invalid; allowed: one number in [-1, 1]")
-        return self.config.max_burn_m_s * max(float(value.reshape(())), 0.0)
+        if value.shape not in ((), (1,)) or np.isnan(value).any():
+            raise ValueError(f"action={action!r} is invalid; allowed: one number, not NaN (clipped to [-1, 1])")
+        return self.config.max_burn_m_s * min(max(float(value.reshape(())), 0.0), 1.0)
 
     def requested_dvs(self, actions: Any, n: int) -> FloatArray:
-        """The burns [m/s] a batch of ``n`` actions asks for; ValueError outside the batched action space."""
+        """The burns [m/s] a batch of ``n`` actions asks for; ValueError outside the batched action space.
+
+        Continuous actions are clipped to [-1, 1] as in `requested_dv`; NaN is a ValueError.
+        """
         a = np.asarray(actions)
         sizes = self.burn_sizes_m_s
         if not self.continuous:
@@ -231,10 +238,9 @@ class Task:
         if a.shape not in ((n, 1), (n,)):
             raise ValueError(f"actions of shape {a.shape} are invalid; allowed: shape ({n}, 1)")
         a = a.reshape(n).astype(np.float64)
-        bad = ~(np.abs(a) <= 1.0)
-        if bad.any():
-            raise ValueError(f"action {a[bad][0].item()!r} is invalid; allowed: numbers in [-1, 1]")
-        return self.config.max_burn_m_s * np.maximum(a, 0.0)
+        if np.isnan(a).any():
+            raise ValueError("action nan is invalid; allowed: numbers, not NaN (clipped to [-1, 1])")
+        return self.config.max_burn_m_s * np.clip(a, 0.0, 1.0)
 
     def encode(self, dv_m_s: FloatArray) -> Any:
         """Actions for requested burns: the largest discrete size not above each, or the Box value."""
