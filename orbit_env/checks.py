@@ -24,7 +24,7 @@ How to use it:
   (``label=``, ``value_text=``, ``scale=``, ``unit=``, ``rename=``): the error keeps
   the parameter's name, value, unit and bounds as data for that.
 
-Example:
+Examples:
     >>> check_number(400, "perigee_km", unit="km", low=100, high=50_000)
     400.0
     >>> check_number(50, "perigee_km", unit="km", low=100, high=50_000)

@@ -267,7 +267,7 @@ def lifetime(
             local solar time (else local time is averaged over).
         chunk_days: Time step of the time-stepped path.
 
-    Example:
+    Examples:
         >>> result = lifetime(360, 800)
         >>> round(result.nu, -1), round(result.revolutions, -2)
         (2910.0, 7600.0)
@@ -487,7 +487,7 @@ def check_rule(
     (`orbit_env.decay.lifetime_mean`, as `lifetime` gives it), the same air for every
     candidate perigee.
 
-    Example:
+    Examples:
         >>> check = check_rule(800, 800, 25, satellite=Satellite(2.2, 100.0, 1.0))
         >>> bool(check.complies[0]), round(float(check.new_perigee_m[0]) / 1e3)
         (False, 590)

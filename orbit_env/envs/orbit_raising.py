@@ -54,16 +54,15 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     ``Box(low, high, (7,), float32)``, the same in every variant:
 
-    | Num | Observation         | Unit and scaling                               | Min | Max |
-    |-----|---------------------|------------------------------------------------|-----|-----|
-    | 0   | perigee height      | m / ``HEIGHT_SCALE_M`` (1000 km)               | 0.1 | 1.2 |
-    | 1   | apogee height       | m / ``HEIGHT_SCALE_M`` (1000 km)               | 0.1 | 5   |
-    | 2   | delta-v left        | m/s / ``DV_SCALE_M_S`` (1 km/s), rocket eq.    | 0   | 3   |
-    | 3   | mission clock       | steps taken / ``horizon_steps``                | 0   | 1   |
-    | 4   | predicted lifetime  | L / (L + 365 d), L in days, no burns, nominal  | 0   | 1   |
-    |     |                     | density (``DensityConfig.nominal_scale``)      |     |     |
-    | 5   | apogee drop         | d / (d + 10 km), d = drop over the last coast  | 0   | 1   |
-    | 6   | perigee drop        | d / (d + 1 km), d = drop over the last coast   | 0   | 1   |
+    | Num | Observation        | Unit and scaling                                                         | Min | Max |
+    |-----|--------------------|--------------------------------------------------------------------------|-----|-----|
+    | 0   | perigee height     | m / ``HEIGHT_SCALE_M`` (1000 km)                                         | 0.1 | 1.2 |
+    | 1   | apogee height      | m / ``HEIGHT_SCALE_M`` (1000 km)                                         | 0.1 | 5   |
+    | 2   | delta-v left       | m/s / ``DV_SCALE_M_S`` (1 km/s), rocket eq.                              | 0   | 3   |
+    | 3   | mission clock      | steps taken / ``horizon_steps``                                          | 0   | 1   |
+    | 4   | predicted lifetime | L / (L + 365 d), L in days, no burns, at ``DensityConfig.nominal_scale`` | 0   | 1   |
+    | 5   | apogee drop        | d / (d + 10 km), d = drop over the last coast                            | 0   | 1   |
+    | 6   | perigee drop       | d / (d + 1 km), d = drop over the last coast                             | 0   | 1   |
 
     This is what a ground station knows: the tracked orbit, the propellant, the
     time, its own prediction of the lifetime from the paper's tables, and the decay
@@ -146,20 +145,19 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     * v0: initial version.
 
-    ## Example
-
-    >>> import gymnasium as gym
-    >>> from orbit_env.envs import register_envs
-    >>> register_envs()
-    >>> env = gym.make("OrbitRaising-v0")
-    >>> obs, info = env.reset(seed=0, options={"perigee_km": 360.0, "apogee_km": 700.0})
-    >>> obs.shape, obs.dtype
-    ((7,), dtype('float32'))
-    >>> obs, reward, terminated, truncated, info = env.step(3)  # a 100 m/s burn
-    >>> round(info["burn_m_s"]), terminated
-    (100, False)
-    >>> bool(obs[1] > 0.9)  # the apogee went from 700 km to about 1100 km
-    True
+    Examples:
+        >>> import gymnasium as gym
+        >>> from orbit_env.envs import register_envs
+        >>> register_envs()
+        >>> env = gym.make("OrbitRaising-v0")
+        >>> obs, info = env.reset(seed=0, options={"perigee_km": 360.0, "apogee_km": 700.0})
+        >>> obs.shape, obs.dtype
+        ((7,), dtype('float32'))
+        >>> obs, reward, terminated, truncated, info = env.step(3)  # a 100 m/s burn
+        >>> round(info["burn_m_s"]), terminated
+        (100, False)
+        >>> bool(obs[1] > 0.9)  # the apogee went from 700 km to about 1100 km
+        True
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 8}

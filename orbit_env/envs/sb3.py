@@ -7,10 +7,11 @@ vector environment that resets finished episodes in the same step
 for all satellites instead of ``DummyVecEnv``'s Python loop over single environments.
 Needs ``pip install 'orbit-env[train]'``.
 
->>> from orbit_env.envs.sb3 import make_sb3_vec_env
->>> venv = make_sb3_vec_env("OrbitRaising-v0", num_envs=8, seed=0)
->>> venv.reset().shape
-(8, 7)
+Examples:
+    >>> from orbit_env.envs.sb3 import make_sb3_vec_env
+    >>> venv = make_sb3_vec_env("OrbitRaising-v0", num_envs=8, seed=0)
+    >>> venv.reset().shape
+    (8, 7)
 """
 
 from __future__ import annotations

@@ -333,7 +333,7 @@ class MsisAtmosphere:
             Sun-synchronous orbit [h]; None (default) averages over local time.
         scale: Multiplier on the whole profile.
 
-    Example:
+    Examples:
         >>> atmosphere = MsisAtmosphere(150.0, 150.0, 15.0, inclination_deg=51.6)
         >>> 1e-12 < float(atmosphere.density_kg_m3(400e3)) < 1e-11
         True
