@@ -81,3 +81,122 @@ def test_continuous_actions_outside_the_box_are_clipped_and_nan_refused():
     np.testing.assert_array_equal(info["burn_m_s"], [100.0, 0.0, 50.0])
     with pytest.raises(ValueError, match=r"action nan is invalid; allowed: numbers, not NaN \(clipped to \[-1, 1\]\)"):
         vec.step(np.array([[0.0], [np.nan], [0.0]]))
+
+
+# --------------------------------------------------------------------------------------
+# info: the episode's outcome so far at every step and reset, single and vector env
+# --------------------------------------------------------------------------------------
+
+OUTCOME = ("reentered", "days_in_orbit", "dv_used_m_s")
+STARTS = [  # re-enters inside a 40-step horizon, and outlives it
+    {"perigee_km": 170.0, "apogee_km": 300.0},
+    {"perigee_km": 400.0, "apogee_km": 900.0},
+]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_info_holds_the_outcome_so_far_at_every_step(env_id):
+    env = gym.make(env_id, horizon_steps=40)
+    for start in STARTS:
+        _, info = env.reset(seed=0, options=start)
+        assert info == {"reentered": False, "days_in_orbit": 0.0, "dv_used_m_s": 0.0}
+        rewards, burns = 0.0, 0.0
+        for k in range(40):
+            action = env.action_space.sample() if k < 5 else env.action_space.sample() * 0
+            _, reward, terminated, truncated, info = env.step(action)
+            assert set(info) == {"burn_m_s", *OUTCOME}
+            assert type(info["reentered"]) is bool and info["reentered"] == terminated
+            rewards += reward
+            burns += info["burn_m_s"]
+            assert info["dv_used_m_s"] == pytest.approx(burns, abs=1e-9)
+            # reward = days in orbit during the step - cost x burn
+            assert info["days_in_orbit"] == pytest.approx(rewards + 0.4 * burns, abs=1e-9)
+            assert info["days_in_orbit"] == env.unwrapped.state["time_days"]
+            if terminated or truncated:
+                break
+        assert info["reentered"] == (start is STARTS[0])
+
+
+def vector_and_singles(env_id, mode):
+    vec = gym.make_vec(
+        env_id, num_envs=2, vectorization_mode="vector_entry_point", horizon_steps=40, autoreset_mode=mode
+    )
+    singles = [gym.make(env_id, horizon_steps=40) for _ in STARTS]
+    return vec, singles
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_vector_info_holds_the_outcome_as_gymnasiums_vector_api(env_id):
+    from gymnasium.vector import AutoresetMode
+
+    options = {key: np.array([s[key] for s in STARTS]) for key in STARTS[0]}
+    options["density_scale"] = np.ones(2)
+    options["density_phase_rad"] = np.zeros(2)
+    for mode in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+        vec, singles = vector_and_singles(env_id, mode)
+        _, info = vec.reset(seed=0, options=options)
+        for key in OUTCOME:
+            assert info[f"_{key}"].all()
+        np.testing.assert_array_equal(info["reentered"], [False, False])
+        assert info["reentered"].dtype == np.bool_
+        np.testing.assert_array_equal(info["days_in_orbit"], [0.0, 0.0])
+        np.testing.assert_array_equal(info["dv_used_m_s"], [0.0, 0.0])
+        for i, single in enumerate(singles):
+            single.reset(seed=0, options={key: float(value[i]) for key, value in options.items()})
+        vec.action_space.seed(3)
+        ended = [False, False]
+        for _ in range(41):
+            actions = vec.action_space.sample()
+            _, _, terminated, truncated, info = vec.step(actions)
+            for key in OUTCOME:
+                assert info[f"_{key}"].all()  # every row has an outcome: the episode's, or the new one's
+            for i, single in enumerate(singles):
+                if ended[i]:
+                    continue
+                *_, single_info = single.step(actions[i])
+                done = bool(terminated[i] or truncated[i])
+                seen = info["final_info"] if done and mode is AutoresetMode.SAME_STEP else info
+                assert seen[f"_{OUTCOME[0]}"][i]
+                assert bool(seen["reentered"][i]) == single_info["reentered"]
+                assert seen["days_in_orbit"][i] == pytest.approx(single_info["days_in_orbit"], rel=1e-9)
+                assert seen["dv_used_m_s"][i] == pytest.approx(single_info["dv_used_m_s"], abs=1e-9)
+                if done:
+                    ended[i] = True
+                    if mode is AutoresetMode.SAME_STEP:  # the row already holds the new episode
+                        assert not info["reentered"][i] and info["days_in_orbit"][i] == 0.0
+                        assert info["dv_used_m_s"][i] == 0.0
+            if mode is AutoresetMode.NEXT_STEP:
+                restarted = ~info["_burn_m_s"]  # NEXT_STEP: the rows that started anew in this step
+                assert not info["reentered"][restarted].any()
+                assert (info["days_in_orbit"][restarted] == 0.0).all()
+                assert (info["dv_used_m_s"][restarted] == 0.0).all()
+        assert all(ended)
+        # A masked reset reports only the masked rows, as SyncVectorEnv.
+        _, info = vec.reset(options={"reset_mask": np.array([False, True])})
+        np.testing.assert_array_equal(info["_days_in_orbit"], [False, True])
+        assert info["days_in_orbit"][1] == 0.0
+
+
+def test_sb3_infos_hold_each_finished_episodes_outcome():
+    pytest.importorskip("stable_baselines3")
+    from orbit_env.envs.sb3 import SB3VecEnv
+
+    # SB3VecEnv directly: the outcome is the adapter's, whatever make_sb3_vec_env wraps around it.
+    vec = gym.make_vec(
+        "OrbitRaising-v0",
+        num_envs=2,
+        vectorization_mode="vector_entry_point",
+        horizon_steps=40,
+        autoreset_mode="SameStep",
+    )
+    venv = SB3VecEnv(vec)
+    venv.set_options(STARTS)
+    venv.reset()
+    finished = {}
+    for _ in range(40):
+        _, _, dones, infos = venv.step(np.zeros(2, dtype=np.int64))
+        for i in np.flatnonzero(dones):
+            finished.setdefault(int(i), infos[i])
+        assert all(set(OUTCOME).isdisjoint(infos[i]) for i in np.flatnonzero(~dones))
+    assert finished[0]["reentered"] is True and 0.0 < finished[0]["days_in_orbit"] < 40.0
+    assert finished[1]["reentered"] is False and finished[1]["dv_used_m_s"] == 0.0

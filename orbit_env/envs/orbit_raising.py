@@ -70,8 +70,8 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``OrbitRaisingUncertain-v0`` the true density scale is not observed and only
     the observed decay (5, 6) against the prediction (4) reveals it. "Min" is the
     least value the env produces; the Box's low is 0 for every component. The
-    clock is held at 1 past ``horizon_steps``. ``info["burn_m_s"]`` is the burn
-    made, and ``env.unwrapped.state`` the simulator's state (for tests and plots).
+    clock is held at 1 past ``horizon_steps``. ``env.unwrapped.state`` is the
+    simulator's state (for tests and plots).
 
     ## Rewards
 
@@ -104,6 +104,21 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``max_episode_steps`` given to ``gymnasium.make`` adds Gymnasium's ``TimeLimit``
     outside the environment, which cannot see it, and the spec then reports that
     limit: pass ``horizon_steps`` instead.)
+
+    ## Info
+
+    ``step`` returns ``info["burn_m_s"]``, the burn made in the step [m/s] (after the
+    cuts above); ``step`` and ``reset`` return the episode so far:
+
+    | Key               | Meaning                                                         |
+    |-------------------|-----------------------------------------------------------------|
+    | ``reentered``     | bool: the satellite has re-entered (equals ``terminated``)      |
+    | ``days_in_orbit`` | days in orbit since the start (the mission time; at re-entry,   |
+    |                   | the exact life); the return is this less the propellant's cost |
+    | ``dv_used_m_s``   | delta-v burnt since the start [m/s], the sum of ``burn_m_s``    |
+
+    At ``reset`` they are False, 0 and 0. The vector environment returns the same keys
+    as arrays with Gymnasium's ``_key`` masks.
 
     ## Arguments
 
@@ -186,6 +201,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         self._state: TaskState | None = None
         self._track: list[tuple[float, float, float]] = []  # (perigee, apogee, burn) for render()
         self._last_burn_m_s = 0.0
+        self._dv_used_m_s = 0.0  # the burns of the episode so far, for info["dv_used_m_s"]
         self._renderer: Any = None
 
     @property
@@ -239,11 +255,12 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         super().reset(seed=seed)
         self._state = state = task_model.start(self.task, self.np_random, None, options)
         self._last_burn_m_s = 0.0
+        self._dv_used_m_s = 0.0
         if self.render_mode is not None:
             self._track = [(state.perigee_m, state.apogee_m, 0.0)]
             if self.render_mode == "human":
                 self.render()
-        return task_model.observe(self.task, state), {}
+        return task_model.observe(self.task, state), self._outcome()
 
     def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
         """Burn (maybe), then coast ``revolutions_per_step`` revolutions."""
@@ -253,6 +270,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         task = self.task
         requested = task.requested_dv(action)
         result = task_model.step(task, state, requested)
+        self._dv_used_m_s += result.burn_m_s
         if self.render_mode is not None:
             if result.burn_m_s > 0.0:
                 # The orbit the burn made, before the coast: the heights less the coast's drops.
@@ -269,8 +287,13 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
             result.reward,
             bool(result.terminated),
             bool(result.truncated),
-            {"burn_m_s": result.burn_m_s},
+            {"burn_m_s": result.burn_m_s, **self._outcome()},
         )
+
+    def _outcome(self) -> dict[str, Any]:
+        """The episode so far, for ``info``: re-entered, days in orbit, delta-v burnt."""
+        state = self._state
+        return {"reentered": state.tau <= 0.0, "days_in_orbit": state.time_days, "dv_used_m_s": self._dv_used_m_s}
 
     def render(self) -> Any:
         """Draw the (apogee, perigee) plane with the track (rgb_array, human) or one text line (ansi)."""

@@ -23,6 +23,8 @@ import gymnasium
 import numpy as np
 from gymnasium.vector import AutoresetMode
 
+from orbit_env.envs.vector import OUTCOME_KEYS
+
 try:
     from stable_baselines3.common.vec_env import VecEnv
     from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvStepReturn
@@ -38,7 +40,9 @@ class SB3VecEnv(VecEnv):
     Finished episodes follow SB3's convention: the returned observation starts the
     next episode, ``infos[i]["terminal_observation"]`` is the last one of the
     finished episode and ``infos[i]["TimeLimit.truncated"]`` tells truncation from
-    termination (for value bootstrapping). Attributes and methods act on the whole
+    termination (for value bootstrapping), and ``reentered``, ``days_in_orbit`` and
+    ``dv_used_m_s`` its outcome (see `OrbitRaisingEnv`; only at the episode's end, so
+    that a step builds no dicts for the others). Attributes and methods act on the whole
     batch, so ``get_attr`` returns the batch's value once per index.
 
     Seeding: ``seed(s)`` then ``reset()`` seeds the batch's one generator with
@@ -90,10 +94,13 @@ class SB3VecEnv(VecEnv):
         dones = terminated | truncated
         infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         if dones.any():
-            final_obs = info["final_obs"]
+            final_obs, final_info = info["final_obs"], info["final_info"]
             for i in np.flatnonzero(dones):
                 infos[i]["terminal_observation"] = final_obs[i]
                 infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+                for key in OUTCOME_KEYS:  # the finished episode's outcome, e.g. for VecMonitor's info_keywords
+                    if key in final_info:
+                        infos[i][key] = final_info[key][i].item()
         return obs, rewards.astype(np.float32), dones, infos
 
     def close(self) -> None:

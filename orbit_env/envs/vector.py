@@ -9,11 +9,12 @@ universal curves moves every satellite. The vector environment owns truncation
 * ``AutoresetMode.NEXT_STEP`` (default, as ``SyncVectorEnv`` and ``CartPoleVectorEnv``):
   the step that ends an episode returns its last observation; the next step ignores
   that satellite's action and returns the first observation of a new episode, with
-  reward 0, not terminated, not truncated, and no ``info["burn_m_s"]`` there.
+  reward 0, not terminated, not truncated, and no ``info["burn_m_s"]`` there (the
+  outcome keys there describe the new episode, as its reset's info would).
 * ``AutoresetMode.SAME_STEP``: the step that ends an episode returns the first
   observation of the new one; ``info["final_obs"]`` and ``info["final_info"]`` hold
-  the last observation and info of the old (the convention of Stable-Baselines3,
-  see `orbit_env.envs.sb3`).
+  the last observation and info of the old, the outcome keys of the finished episode
+  among them (the convention of Stable-Baselines3, see `orbit_env.envs.sb3`).
 * ``AutoresetMode.DISABLED``: no restarts; reset finished satellites with
   ``reset(options={"reset_mask": mask})`` before stepping them again.
 """
@@ -33,6 +34,8 @@ from orbit_env.envs.task import BatchState, Task, TaskView
 
 FloatArray = NDArray[np.float64]
 
+#: The keys of ``info`` that describe each episode so far (with their ``_key`` masks).
+OUTCOME_KEYS = ("reentered", "days_in_orbit", "dv_used_m_s")
 #: The keywords of the vector environment besides the config's and the density's fields.
 _ENV_KEYWORDS = ("num_envs", "config", "continuous", "density", "max_episode_steps", "render_mode", "autoreset_mode")
 
@@ -43,7 +46,11 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     Observation, action, reward and episode end are those of
     `orbit_env.envs.orbit_raising.OrbitRaisingEnv` (read its docstring),
     batched: observations (num_envs, 7) float32, rewards float64, actions of shape
-    (num_envs,) (discrete) or (num_envs, 1) (continuous). Truncation after
+    (num_envs,) (discrete) or (num_envs, 1) (continuous). ``info`` holds the single
+    environment's keys as arrays of shape (num_envs,), each with its boolean mask
+    ``info["_key"]`` as in Gymnasium's vector API: ``burn_m_s`` after a step, and
+    ``reentered``, ``days_in_orbit`` and ``dv_used_m_s`` (`OUTCOME_KEYS`, each
+    episode so far) after every step and reset. Truncation after
     ``config.horizon_steps`` steps. Finished missions restart as ``autoreset_mode``
     says (see the module; ``metadata["autoreset_mode"]`` tells which).
 
@@ -115,6 +122,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
         self._everyone_mask.flags.writeable = False
         self._finished = np.zeros(0, dtype=np.intp)  # ended in the last step (NEXT_STEP, DISABLED)
+        self._dv_used_m_s = np.zeros(self.num_envs)  # the burns of each episode so far, for info
 
     @property
     def state(self) -> dict[str, FloatArray]:
@@ -157,11 +165,13 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         else:
             fresh = task_model.start(self.task, self.np_random, idx.size, options or None)
             self._state.put(idx, fresh)
+            self._dv_used_m_s[idx] = 0.0
             obs[idx] = task_model.observe(self.task, fresh)
         self._has_state = True
         self._last_obs = obs
         self._finished = np.setdiff1d(self._finished, idx, assume_unique=True) if mask is not None else idx[:0]
-        return obs, {}
+        reset = self._everyone_mask if mask is None else mask.copy()  # as SyncVectorEnv: the reset rows' info
+        return obs, self._outcome(self._state.tau <= 0.0, reset)
 
     def _masked(self, mask: Any) -> NDArray[np.intp]:
         """The sub-environments a ``reset_mask`` names; ValueError as Gymnasium's for a bad mask."""
@@ -204,8 +214,10 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             stepped = np.ones(self.num_envs, dtype=np.bool_)
             stepped[restart] = False
             infos["_burn_m_s"] = stepped
+        self._dv_used_m_s += dv
         done = terminated | truncated
         finished = np.flatnonzero(done)
+        infos.update(self._outcome(terminated.copy(), self._everyone_mask))
         if self.autoreset_mode is not AutoresetMode.SAME_STEP:
             self._finished = finished
         elif finished.size:
@@ -214,12 +226,27 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             infos["final_obs"] = final_obs
             infos["_final_obs"] = done
             # As SyncVectorEnv: the old episode's info moves to final_info, the new one's (empty) stays.
-            infos["final_info"] = {"burn_m_s": dv, "_burn_m_s": done}
+            final_info = {"burn_m_s": dv, "_burn_m_s": done}
+            for key in OUTCOME_KEYS:
+                final_info[key], final_info[f"_{key}"] = infos[key].copy(), done
+                infos[key][finished] = 0  # the new episode's: not re-entered, 0 days, nothing burnt
+            infos["final_info"] = final_info
             infos["_final_info"] = done
             infos["_burn_m_s"] = ~done
             obs[finished] = self._restart(finished)
         self._last_obs = obs
         return obs, reward, terminated, truncated, infos
+
+    def _outcome(self, reentered: NDArray[np.bool_], mask: NDArray[np.bool_]) -> dict[str, Any]:
+        """The episodes so far, for ``info`` (`OUTCOME_KEYS`, each with its mask as Gymnasium's vector API)."""
+        return {
+            "reentered": reentered,
+            "_reentered": mask,
+            "days_in_orbit": self._state.time_days.copy(),
+            "_days_in_orbit": mask,
+            "dv_used_m_s": self._dv_used_m_s.copy(),
+            "_dv_used_m_s": mask,
+        }
 
     def _restart(self, idx: NDArray[np.intp]) -> NDArray[np.float32]:
         """Automatic reset of ``idx``: copy fresh missions from the pool; return their observations.
@@ -236,4 +263,5 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         take = slice(self._pool_next, self._pool_next + idx.size)
         self._pool_next += idx.size
         self._state.put(idx, self._pool.data[:, take])
+        self._dv_used_m_s[idx] = 0.0
         return self._pool_obs[take]
