@@ -89,8 +89,8 @@ def test_register_envs_is_idempotent_and_uses_string_entry_points():
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_gymnasium_check_env_passes_without_warnings(env_id):
-    # Without the render check: check_env would render in every mode, "human" too, which on a machine
-    # without a window refuses (test_render_modes checks rgb_array and ansi; tests/test_render.py the refusal).
+    # Without the render check: check_env would render in every mode, and "human" without a window
+    # warns (tests/test_render.py runs the full check headless; test_render_modes checks rgb_array and ansi).
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         check_env(make(env_id).unwrapped, skip_render_check=True)

@@ -135,7 +135,9 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``autoreset_mode``.
     ``render_mode``: "human" and "rgb_array" draw the (apogee, perigee) plane of
     the paper's Fig. 2 with the track and the burns (needs ``orbit-env[plot]``);
-    "ansi" returns one line of text.
+    "ansi" returns one line of text. Where "human" can open no window (no display,
+    or a matplotlib backend that draws none) it warns once and draws nothing, so
+    Gymnasium's ``check_env`` passes on headless machines.
 
     ## Why these defaults
 

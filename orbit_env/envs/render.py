@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from typing import Any
 
 import numpy as np
@@ -84,8 +85,8 @@ def background_curves() -> tuple[list[NDArray[np.float64]], list[NDArray[np.floa
 FILE_BACKENDS = frozenset({"agg", "cairo", "pdf", "pgf", "ps", "svg", "template"})
 
 
-def check_window(backend: str) -> None:
-    """Refuse ``render_mode="human"`` where no window can open, saying what is missing.
+def missing_window(backend: str) -> str | None:
+    """Why ``render_mode="human"`` can open no window here, or None if it can.
 
     Without a display matplotlib falls back to a backend that draws into memory, and a
     "human" render would show nothing at all.
@@ -93,25 +94,30 @@ def check_window(backend: str) -> None:
     Args:
         backend: Matplotlib's backend (``matplotlib.get_backend()``).
 
-    Raises:
-        RuntimeError: ``backend`` cannot open a window; the message names the backend,
-            the display variables (on Linux) and the render modes that need none.
+    Returns:
+        None where a window can open; else a message that names the backend, the
+        display variables (on Linux) and the render modes that need no window.
     """
     name = backend.lower()
     if name not in FILE_BACKENDS:
-        return
+        return None
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         missing = "a display: neither DISPLAY nor WAYLAND_DISPLAY is set"
     else:
         missing = "an interactive matplotlib backend (MPLBACKEND or matplotlib.use, e.g. TkAgg or QtAgg)"
-    raise RuntimeError(
+    return (
         f"render_mode='human' opens a window, which needs {missing}, and matplotlib's backend is "
-        f"{backend!r}, which draws no window; use render_mode='rgb_array' (frames as arrays) or 'ansi' (text)"
+        f"{backend!r}, which draws no window, so the environment draws nothing; use "
+        "render_mode='rgb_array' (frames as arrays) or 'ansi' (text)"
     )
 
 
 class TrackRenderer:
     """Draws a mission's track on the (apogee, perigee) plane.
+
+    In human mode where no window can open (no display: CI machines, clusters) it
+    warns once (`missing_window`) and draws nothing, so that Gymnasium's ``check_env``,
+    which makes every declared render mode, passes there.
 
     Args:
         human: Show the figure in a window (pyplot) instead of returning pixels.
@@ -122,10 +128,14 @@ class TrackRenderer:
         matplotlib = _matplotlib()
         self.human = human
         self.fps = fps
+        self.figure: Any = None
         if human:
+            missing = missing_window(matplotlib.get_backend())
+            if missing is not None:
+                warnings.warn(missing, UserWarning, stacklevel=2)
+                return  # no figure: draw() shows nothing
             import matplotlib.pyplot as plt
 
-            check_window(matplotlib.get_backend())
             self._plt = plt
             self.figure = plt.figure(figsize=FIGURE_SIZE_IN, dpi=FIGURE_DPI)
         else:
@@ -160,6 +170,8 @@ class TrackRenderer:
         self, track: list[tuple[float, float, float]], *, time_days: float, dv_left_m_s: float
     ) -> NDArray[np.uint8] | None:
         """Draw the track [(perigee [m], apogee [m], burn [m/s]), ...]; pixels (rgb_array) or None (human)."""
+        if self.figure is None:
+            return None  # human mode without a window
         points = np.array([(apogee, perigee) for perigee, apogee, _ in track]) / 1e3 if track else np.zeros((0, 2))
         self._track.set_data(points[:, 0], points[:, 1])
         self._now.set_data(points[-1:, 0], points[-1:, 1])
@@ -177,5 +189,5 @@ class TrackRenderer:
 
     def close(self) -> None:
         """Close the window (human mode) and free the figure."""
-        if self.human:
+        if self.human and self.figure is not None:
             self._plt.close(self.figure)
