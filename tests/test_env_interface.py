@@ -200,3 +200,32 @@ def test_sb3_infos_hold_each_finished_episodes_outcome():
         assert all(set(OUTCOME).isdisjoint(infos[i]) for i in np.flatnonzero(~dones))
     assert finished[0]["reentered"] is True and 0.0 < finished[0]["days_in_orbit"] < 40.0
     assert finished[1]["reentered"] is False and finished[1]["dv_used_m_s"] == 0.0
+
+
+# --------------------------------------------------------------------------------------
+# "orbit_env:OrbitRaising-v0" works without importing orbit_env first (docs/getting-started.md)
+# --------------------------------------------------------------------------------------
+
+MODULE_ID = """
+import sys
+import gymnasium as gym
+assert "orbit_env" not in sys.modules
+env = gym.make("orbit_env:OrbitRaising-v0")
+env.reset(seed=0)
+vec = gym.make_vec("orbit_env:OrbitRaisingContinuous-v0", num_envs=2, vectorization_mode="vector_entry_point")
+print(type(env.unwrapped).__name__, type(vec.unwrapped).__name__, env.spec.id)
+"""
+
+
+def test_the_module_id_form_registers_the_envs_itself():
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", MODULE_ID], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split() == ["OrbitRaisingEnv", "OrbitRaisingVectorEnv", "OrbitRaising-v0"]
+    # The page that says so.
+    from pathlib import Path
+
+    page = Path(__file__).parents[1] / "docs" / "getting-started.md"
+    assert 'gym.make("orbit_env:OrbitRaising-v0")' in page.read_text()
