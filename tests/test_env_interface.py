@@ -229,3 +229,24 @@ def test_the_module_id_form_registers_the_envs_itself():
 
     page = Path(__file__).parents[1] / "docs" / "getting-started.md"
     assert 'gym.make("orbit_env:OrbitRaising-v0")' in page.read_text()
+
+
+# --------------------------------------------------------------------------------------
+# Version history: the dynamics change under -v0 is recorded where users look
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_version_history_records_the_burn_relocation_fix(env_id):
+    from pathlib import Path
+
+    single = gym.make(env_id).unwrapped
+    vec = gym.make_vec(env_id, num_envs=1, vectorization_mode="vector_entry_point").unwrapped
+    for doc in (" ".join(type(single).__doc__.split()), " ".join(type(vec).__doc__.split())):
+        history = doc[doc.index("Version History") :]
+        assert "2026-12-03" in history and "burn relocation fix" in history
+    assert "any change to the returns bumps the id's version" in " ".join(type(single).__doc__.split())
+    changelog = " ".join((Path(__file__).parents[1] / "CHANGELOG.md").read_text().split())
+    unreleased = changelog[changelog.index("## [Unreleased]") :]
+    fixed = unreleased[unreleased.index("### Fixed") :]
+    assert "2026-12-03 (the burn relocation fix)" in fixed and "bumps the id's" in fixed

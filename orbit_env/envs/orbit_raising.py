@@ -160,7 +160,17 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     ## Version History
 
+    Nothing is released yet; from the first release on, any change to the returns
+    bumps the id's version (Gymnasium's convention: ``-v0`` becomes ``-v1``). See
+    CHANGELOG.md.
+
     * v0: initial version.
+    * v0, dynamics changed 2026-12-03 (the burn relocation fix; unreleased, so the id
+      stayed): a burn moves the orbit from its point on the universal curves by table
+      A's difference, where it had been placed where table A puts the new heights (a
+      burn of 1e-9 m/s then changed a year's return by +0.02 to +0.14 day), and
+      ``decode`` inverts table B exactly (it was up to 0.1% off in nu). Returns of
+      policies that burn differ from those measured before that date.
 
     Examples:
         >>> import gymnasium as gym

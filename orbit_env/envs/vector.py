@@ -59,6 +59,9 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     ones. All randomness is drawn from ``self.np_random``, one stream for the
     batch: sub-environment i is not the single environment seeded with seed + i.
 
+    Version History: that of `OrbitRaisingEnv` (the same ids and dynamics),
+    including the dynamics change of 2026-12-03 (the burn relocation fix).
+
     Args:
         num_envs: Number of satellites.
         config: Satellite and task (default ``OrbitRaisingConfig()``).
