@@ -53,7 +53,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 try:
-    from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
+    from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecMonitor
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("reward shaping needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
 
@@ -95,6 +95,15 @@ def burns_cannot_pay_once_the_mission_is_covered(config: OrbitRaisingConfig) -> 
     return period_gain_days_per_m_s(config) < config.propellant_cost_per_m_s
 
 
+def _monitored(venv: VecEnv) -> bool:
+    """Whether a ``VecMonitor`` is among the wrappers of ``venv``."""
+    while isinstance(venv, VecEnvWrapper):
+        if isinstance(venv, VecMonitor):
+            return True
+        venv = venv.venv
+    return False
+
+
 class NeverBurnValueShaping(VecEnvWrapper):
     """Reward r + Phi(s') - Phi(s), Phi(s') = 0 where the episode ended (see the module).
 
@@ -102,14 +111,16 @@ class NeverBurnValueShaping(VecEnvWrapper):
     ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
 
     Args:
-        venv: The SB3 view of an orbit-raising vector env (`orbit_env.envs.sb3`).
+        venv: The SB3 view of an orbit-raising vector env (`orbit_env.envs.sb3`);
+            with ``end_decided`` > 0, unmonitored (``make_sb3_vec_env(..., monitor=False)``).
         end_decided: Probability that a step from a decided state ends its episode
             (0: never; see the module).
         seed: Seed of those draws.
 
     Raises:
         ValueError: ``end_decided`` outside [0, 1], or > 0 where it would not be
-            exact: a drifting or unknown density, or burns that can pay by the period.
+            exact: a drifting or unknown density, or burns that can pay by the period;
+            or > 0 above a ``VecMonitor``.
     """
 
     def __init__(self, venv: VecEnv, end_decided: float = 0.0, seed: int | None = None) -> None:
@@ -127,6 +138,12 @@ class NeverBurnValueShaping(VecEnvWrapper):
                     f"end_decided is not exact for this config: a burn may add "
                     f"{period_gain_days_per_m_s(env.config):.3f} mission days per m/s by the period, "
                     f"more than its cost {env.config.propellant_cost_per_m_s}"
+                )
+            if _monitored(venv):
+                raise ValueError(
+                    "end_decided ends episodes by resetting the vector env under a VecMonitor, whose returns "
+                    "would then run on into the next episode: wrap make_sb3_vec_env(..., monitor=False) "
+                    "and put the VecMonitor above the shaping"
                 )
         super().__init__(venv)
         self.env = env

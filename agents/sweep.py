@@ -128,12 +128,11 @@ def train_trial(
         return result.model_path
     import stable_baselines3
     import torch
-    from stable_baselines3.common.vec_env import VecMonitor
 
     from orbit_env.envs.sb3 import make_sb3_vec_env
 
     torch.set_num_threads(1)
-    venv = VecMonitor(make_sb3_vec_env(env_id, num_envs=num_envs, seed=seed))
+    venv = make_sb3_vec_env(env_id, num_envs=num_envs, seed=seed)  # monitored: SB3's episode statistics
     model = getattr(stable_baselines3, algo.upper())("MlpPolicy", venv, seed=seed, device="cpu", verbose=0)
     model.learn(total_timesteps=timesteps)
     model.orbit_env = {"env_id": env_id, "env": {}}

@@ -339,6 +339,31 @@ class BestModelCallback(BaseCallback):
         return mean
 
 
+def training_env(config: dict[str, Any]) -> Any:
+    """The SB3 ``VecEnv`` a checked training config trains on, without reward normalization.
+
+    `orbit_env.envs.sb3.make_sb3_vec_env` unmonitored, then `MissionEndIsTerminal`
+    (``bootstrap_at_horizon = false``), the reward shaping, and one ``VecMonitor``
+    above them all, which sees the episodes PPO is trained on.
+    """
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from orbit_env.envs.sb3 import make_sb3_vec_env
+
+    seed = int(config["seed"])
+    venv: Any = make_sb3_vec_env(
+        config["env_id"], num_envs=int(config["num_envs"]), seed=seed, monitor=False, **config["env"]
+    )
+    if not config["bootstrap_at_horizon"]:
+        venv = MissionEndIsTerminal(venv)
+    if config["shaping"] == "never_burn_value":
+        from orbit_env.agents.shaping import never_burn_value_shaping
+
+        # Before VecNormalize: it scales the shaped reward.
+        venv = never_burn_value_shaping(venv, end_decided=float(config["end_decided"]), seed=seed)
+    return VecMonitor(venv)  # episode returns and lengths for tensorboard
+
+
 def _vecnormalize_path(checkpoint: Path) -> Path:
     """The reward statistics CheckpointCallback saves beside ``rl_model_N_steps.zip``."""
     return checkpoint.with_name(checkpoint.name.replace("rl_model_", "rl_model_vecnormalize_")).with_suffix(".pkl")
@@ -383,12 +408,11 @@ def train(
         import torch
         from stable_baselines3 import PPO
         from stable_baselines3.common.callbacks import CheckpointCallback
-        from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+        from stable_baselines3.common.vec_env import VecNormalize
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
 
     import orbit_env  # noqa: F401  (registers the environments)
-    from orbit_env.envs.sb3 import make_sb3_vec_env
 
     config = load_config(config_path)
     source = DEFAULT_CONFIG if config_path is None else str(config_path)
@@ -408,15 +432,7 @@ def train(
     out.mkdir(parents=True, exist_ok=True)
     torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
     seed = int(config["seed"])
-    venv: Any = make_sb3_vec_env(config["env_id"], num_envs=int(config["num_envs"]), seed=seed, **config["env"])
-    if not config["bootstrap_at_horizon"]:
-        venv = MissionEndIsTerminal(venv)
-    if config["shaping"] == "never_burn_value":
-        from orbit_env.agents.shaping import never_burn_value_shaping
-
-        # Before VecNormalize: it scales the shaped reward.
-        venv = never_burn_value_shaping(venv, end_decided=float(config["end_decided"]), seed=seed)
-    venv = VecMonitor(venv)  # episode returns and lengths for tensorboard
+    venv: Any = training_env(config)
     gamma = float(config["ppo"].get("gamma", 0.99))
     if config["normalize"]["reward"]:
         stats = None if checkpoint is None else _vecnormalize_path(checkpoint)

@@ -78,7 +78,9 @@ def test_ending_decided_episodes_is_exact():
     # satellite outlives the mission. Its shaped return plus Phi(s_0) must be what the same actions,
     # then coasting, earn in the plain env: the cut-off tail is worth exactly 0 when shaped.
     n = 32
-    shaped_env = never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=n, seed=11), end_decided=1.0)
+    shaped_env = never_burn_value_shaping(
+        make_sb3_vec_env("OrbitRaising-v0", num_envs=n, seed=11, monitor=False), end_decided=1.0
+    )
     plain_env = make_sb3_vec_env("OrbitRaising-v0", num_envs=n, seed=11)
     np.testing.assert_array_equal(shaped_env.reset(), plain_env.reset())
     phi_start = shaped_env.phi.copy()
@@ -110,6 +112,10 @@ def test_ending_decided_episodes_refuses_where_it_is_not_exact():
         never_burn_value_shaping(make_sb3_vec_env("OrbitRaisingUncertain-v0", num_envs=2), end_decided=0.5)
     with pytest.raises(ValueError, match="probability"):
         never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=2), end_decided=1.5)
+    # Resetting under a VecMonitor would run its returns on into the next episode.
+    with pytest.raises(ValueError, match=r"make_sb3_vec_env\(\.\.\., monitor=False\)"):
+        never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=2), end_decided=1.0)
+    never_burn_value_shaping(make_sb3_vec_env("OrbitRaising-v0", num_envs=2), end_decided=0.0)  # no ends: fine
 
 
 def test_config_rejects_an_unknown_shaping(tmp_path):

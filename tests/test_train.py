@@ -227,3 +227,54 @@ def test_train_logs_episodes_keeps_the_best_resumes_and_keeps_a_finished_run(tmp
     assert "trained 64 timesteps" in capsys.readouterr().out
     model = PPO.load(out / "model.zip", device="cpu")
     assert model.orbit_env["env_id"] == "OrbitRaisingContinuous-v0" and model.n_envs == 4 and model.seed == 3
+
+
+# --------------------------------------------------------------------------------------
+# make_sb3_vec_env is monitored, and nothing monitors twice
+# --------------------------------------------------------------------------------------
+
+
+def monitors(venv):
+    """The number of VecMonitor wrappers in an SB3 VecEnv's chain."""
+    from stable_baselines3.common.vec_env import VecEnvWrapper, VecMonitor
+
+    count = 0
+    while isinstance(venv, VecEnvWrapper):
+        count += isinstance(venv, VecMonitor)
+        venv = venv.venv
+    return count
+
+
+def test_make_sb3_vec_env_is_monitored_for_ep_rew_mean_and_evaluate_policy(tmp_path):
+    import warnings
+
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.evaluation import evaluate_policy
+
+    from orbit_env.envs.sb3 import make_sb3_vec_env
+
+    venv = make_sb3_vec_env("OrbitRaising-v0", num_envs=8, seed=0, horizon_steps=10)
+    assert monitors(venv) == 1
+    model = PPO(
+        "MlpPolicy", venv, n_steps=16, batch_size=64, n_epochs=1, seed=0, device="cpu", tensorboard_log=str(tmp_path)
+    )
+    model.learn(total_timesteps=128)
+    assert "rollout/ep_rew_mean" in scalars(tmp_path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        evaluate_policy(model, venv, n_eval_episodes=8)
+    assert not [w for w in caught if "Monitor" in str(w.message)], [str(w.message) for w in caught]
+    plain = make_sb3_vec_env("OrbitRaising-v0", num_envs=2, monitor=False)
+    assert monitors(plain) == 0
+
+
+def test_training_and_sweep_envs_monitor_once(monkeypatch, tmp_path):
+    from orbit_env.agents import sweep as sweep_module
+    from orbit_env.agents.train import load_config, training_env
+
+    config = load_config(write(tmp_path, TINY))
+    assert monitors(training_env(config)) == 1
+    seen = []
+    monkeypatch.setattr("stable_baselines3.PPO.learn", lambda self, **kwargs: seen.append(monitors(self.get_env())))
+    sweep_module.train_trial("OrbitRaising-v0", "ppo", seed=0, timesteps=8, out_dir=tmp_path / "trial", num_envs=2)
+    assert seen == [1]

@@ -4,7 +4,8 @@ SB3 trains on its own ``VecEnv`` interface; `SB3VecEnv` presents a Gymnasium
 vector environment that resets finished episodes in the same step
 (``AutoresetMode.SAME_STEP``, which `make_sb3_vec_env` asks of
 `orbit_env.envs.vector.OrbitRaisingVectorEnv`) through it: one numpy step
-for all satellites instead of ``DummyVecEnv``'s Python loop over single environments.
+for all satellites instead of ``DummyVecEnv``'s Python loop over single environments;
+it comes wrapped in SB3's ``VecMonitor``, so training logs the episodes' returns.
 Needs ``pip install 'orbit-env[train]'``.
 
 Examples:
@@ -26,7 +27,7 @@ from gymnasium.vector import AutoresetMode
 from orbit_env.envs.vector import OUTCOME_KEYS
 
 try:
-    from stable_baselines3.common.vec_env import VecEnv
+    from stable_baselines3.common.vec_env import VecEnv, VecMonitor
     from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvStepReturn
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError(
@@ -137,14 +138,22 @@ class SB3VecEnv(VecEnv):
 
 
 def make_sb3_vec_env(
-    env_id: str = "OrbitRaising-v0", num_envs: int = 64, seed: int | None = None, **kwargs: Any
-) -> SB3VecEnv:
+    env_id: str = "OrbitRaising-v0", num_envs: int = 64, seed: int | None = None, monitor: bool = True, **kwargs: Any
+) -> VecEnv:
     """``gymnasium.make_vec`` of a registered orbit_env id, ready for Stable-Baselines3.
+
+    Wrapped in SB3's ``VecMonitor`` (as SB3's own ``make_vec_env`` monitors), so a
+    model logs ``rollout/ep_rew_mean`` and ``evaluate_policy`` counts whole episodes;
+    the monitor also keeps each finished episode's outcome (`OUTCOME_KEYS`) in its
+    episode info.
 
     Args:
         env_id: A registered id (see `orbit_env.envs`).
         num_envs: Number of satellites stepped together.
         seed: Seed of the first reset (None: unseeded).
+        monitor: Wrap in ``VecMonitor``. False gives the bare `SB3VecEnv`, for a
+            chain that changes the rewards or the episodes (reward shaping) and puts
+            its own monitor above them.
         **kwargs: Passed to the environment (``config``, ``density``, ...).
     """
     from orbit_env.envs import register_envs
@@ -157,7 +166,9 @@ def make_sb3_vec_env(
         autoreset_mode=AutoresetMode.SAME_STEP,  # SB3's convention: the next episode's first observation
         **kwargs,
     )
-    venv = SB3VecEnv(env)
+    venv: VecEnv = SB3VecEnv(env)
     if seed is not None:
         venv.seed(seed)
+    if monitor:
+        venv = VecMonitor(venv, info_keywords=OUTCOME_KEYS)
     return venv
