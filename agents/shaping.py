@@ -108,7 +108,10 @@ class NeverBurnValueShaping(VecEnvWrapper):
     """Reward r + Phi(s') - Phi(s), Phi(s') = 0 where the episode ended (see the module).
 
     ``infos[i]["unshaped_reward"]`` keeps the environment's reward;
-    ``infos[i]["decided_end"]`` marks an episode ended because it was decided.
+    ``infos[i]["decided_end"]`` marks an episode ended because it was decided; at
+    every episode's end ``infos[i]["mission_return"]`` is the mission's return, the
+    plain environment's (what ``orbit-env evaluate`` scores): the unshaped rewards,
+    plus Phi(s') where a decided episode was ended (the return coasting on earns).
 
     Args:
         venv: The SB3 view of an orbit-raising vector env (`orbit_env.envs.sb3`);
@@ -150,6 +153,7 @@ class NeverBurnValueShaping(VecEnvWrapper):
         self.end_decided = float(end_decided)
         self.phi = np.zeros(self.num_envs)
         self.decided = np.zeros(self.num_envs, dtype=bool)
+        self.unshaped_return = np.zeros(self.num_envs)  # each episode's plain rewards so far
         self.rng = np.random.default_rng(seed)
 
     def _outlook(self) -> tuple[FloatArray, NDArray[np.bool_]]:
@@ -159,6 +163,7 @@ class NeverBurnValueShaping(VecEnvWrapper):
         """Reset the environments and take the potential of the start states."""
         obs = self.venv.reset()
         self.phi, self.decided = self._outlook()
+        self.unshaped_return[:] = 0.0
         return obs
 
     def step_wait(self) -> Any:
@@ -169,11 +174,14 @@ class NeverBurnValueShaping(VecEnvWrapper):
         shaped = rewards + np.where(dones, 0.0, phi_next) - self.phi
         for info, reward in zip(infos, rewards, strict=True):
             info["unshaped_reward"] = float(reward)
+        self.unshaped_return += rewards
+        mission = self.unshaped_return
         if self.end_decided > 0.0:
             end = self.decided & ~dones & (self.rng.random(self.num_envs) < self.end_decided)
             if end.any():
                 # shaped already holds r + Phi(s') - Phi(s) there: the optimal continuation's value.
                 dones = dones | end
+                mission = mission + np.where(end, phi_next, 0.0)  # coasting on from s' earns Phi(s')
                 for i in np.flatnonzero(end):
                     infos[i]["terminal_observation"] = obs[i].copy()
                     infos[i]["decided_end"] = True
@@ -181,6 +189,9 @@ class NeverBurnValueShaping(VecEnvWrapper):
                 phi_new, decided_new = self._outlook()
                 phi_next = np.where(end, phi_new, phi_next)
                 decided_next = np.where(end, decided_new, decided_next)
+        for i in np.flatnonzero(dones):
+            infos[i]["mission_return"] = float(mission[i])
+        self.unshaped_return[dones] = 0.0
         self.phi, self.decided = phi_next, decided_next
         return obs, shaped.astype(np.float32), dones, infos
 

@@ -19,6 +19,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 try:
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.vec_env import VecEnvWrapper
@@ -344,7 +346,8 @@ def training_env(config: dict[str, Any]) -> Any:
 
     `orbit_env.envs.sb3.make_sb3_vec_env` unmonitored, then `MissionEndIsTerminal`
     (``bootstrap_at_horizon = false``), the reward shaping, and one ``VecMonitor``
-    above them all, which sees the episodes PPO is trained on.
+    above them all, which sees the episodes PPO is trained on (with shaping, each
+    episode's ``mission_return`` beside, for `ReturnsCallback`).
     """
     from stable_baselines3.common.vec_env import VecMonitor
 
@@ -361,7 +364,43 @@ def training_env(config: dict[str, Any]) -> Any:
 
         # Before VecNormalize: it scales the shaped reward.
         venv = never_burn_value_shaping(venv, end_decided=float(config["end_decided"]), seed=seed)
-    return VecMonitor(venv)  # episode returns and lengths for tensorboard
+        # Episode returns and lengths for tensorboard, and the mission's return beside the shaped one.
+        return VecMonitor(venv, info_keywords=("mission_return",))
+    return VecMonitor(venv)  # episode returns and lengths for tensorboard: the mission's own
+
+
+class ReturnsCallback(BaseCallback):
+    """Log the return PPO is trained on and the mission's return, under names nobody confuses.
+
+    After every rollout, over SB3's last 100 finished training episodes (actions
+    sampled from the policy):
+
+    * ``mission/return``: the mission's return as ``orbit-env evaluate`` scores it,
+      the plain environment's reward over the whole mission (an episode the shaping
+      ended early counts what coasting on earns, ``infos[i]["mission_return"]`` of
+      `orbit_env.agents.shaping.NeverBurnValueShaping`);
+    * ``rollout/shaped_return``, with shaping only: the shaped, early-ended return PPO
+      maximizes (the mission's less the start's potential), which is also what SB3's
+      own ``rollout/ep_rew_mean`` shows then.
+
+    Args:
+        shaped: Whether the training env shapes its reward.
+    """
+
+    def __init__(self, shaped: bool) -> None:
+        super().__init__()
+        self.shaped = shaped
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_end(self) -> None:
+        episodes = self.model.ep_info_buffer
+        if not episodes:
+            return
+        self.logger.record("mission/return", float(np.mean([e.get("mission_return", e["r"]) for e in episodes])))
+        if self.shaped:
+            self.logger.record("rollout/shaped_return", float(np.mean([e["r"] for e in episodes])))
 
 
 def _vecnormalize_path(checkpoint: Path) -> Path:
@@ -384,9 +423,12 @@ def train(
     """Train PPO as the config says; return where the model went.
 
     The arguments other than ``config_path`` override the config. Episode returns go
-    to tensorboard (``rollout/ep_rew_mean``, by SB3's ``VecMonitor``: with shaping,
-    the shaped return PPO maximizes) and, with ``eval_every``, the plain env's mean
-    return on fixed validation episodes (``eval/mean_reward``, `BestModelCallback`).
+    to tensorboard: ``mission/return``, the mission's return as ``orbit-env evaluate``
+    scores it, and with shaping ``rollout/shaped_return``, the shaped, early-ended
+    return PPO maximizes (`ReturnsCallback`; SB3's ``rollout/ep_rew_mean`` is the
+    return PPO is trained on); with ``eval_every``, the plain env's mean return on
+    fixed validation episodes with deterministic actions (``eval/mean_reward``,
+    `BestModelCallback`).
 
     Args:
         config_path: TOML file of hyperparameters (default: the shipped one).
@@ -446,7 +488,7 @@ def train(
     else:
         model = _new_model(PPO, torch, config, venv, out)
     model.orbit_env = {"env_id": config["env_id"], "env": dict(config["env"])}  # saved with the model
-    callbacks: list[Any] = []
+    callbacks: list[Any] = [ReturnsCallback(shaped=config["shaping"] != "none")]
     every = int(config["checkpoint_every"])
     calls = lambda steps: max(steps // int(config["num_envs"]), 1)  # noqa: E731  (timesteps -> env steps)
     if every > 0:

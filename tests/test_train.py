@@ -278,3 +278,48 @@ def test_training_and_sweep_envs_monitor_once(monkeypatch, tmp_path):
     monkeypatch.setattr("stable_baselines3.PPO.learn", lambda self, **kwargs: seen.append(monitors(self.get_env())))
     sweep_module.train_trial("OrbitRaising-v0", "ppo", seed=0, timesteps=8, out_dir=tmp_path / "trial", num_envs=2)
     assert seen == [1]
+
+
+# --------------------------------------------------------------------------------------
+# orbit-env train logs the shaped return and the mission's, named apart
+# --------------------------------------------------------------------------------------
+
+
+def scalar_values(log_dir, tag):
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    values = []
+    for run in log_dir.iterdir():
+        accumulator = EventAccumulator(str(run))
+        accumulator.Reload()
+        if tag in accumulator.Tags()["scalars"]:
+            values += [event.value for event in accumulator.Scalars(tag)]
+    return values
+
+
+def test_train_logs_the_missions_return_beside_the_shaped_one(tmp_path):
+    from orbit_env.agents.train import train
+
+    # TINY: shaping, decided episodes ended, a 30-step mission; two rollouts.
+    result = train(
+        write(tmp_path, TINY.replace("eval_every = 128", "eval_every = 0")),
+        tmp_path / "run",
+        total_timesteps=256,
+        progress=False,
+    )
+    mission = scalar_values(result.log_dir, "mission/return")
+    shaped = scalar_values(result.log_dir, "rollout/shaped_return")
+    assert len(mission) == len(shaped) == 2
+    # The mission's return is days of a 30-step mission less the propellant's cost; the shaped one is
+    # that less the start's potential (the days coasting earns), which is > 0 for every start here.
+    assert all(0.0 < m <= 30.0 for m in mission)
+    assert all(m > s for m, s in zip(mission, shaped, strict=True))
+    np.testing.assert_allclose(shaped, scalar_values(result.log_dir, "rollout/ep_rew_mean"), rtol=1e-6)
+    # Without shaping the two are one: only mission/return, equal to SB3's ep_rew_mean.
+    plain = TINY.replace('shaping = "never_burn_value"', 'shaping = "none"').replace("end_decided = 1.0", "")
+    plain = plain.replace("eval_every = 128", "eval_every = 0")
+    result = train(write(tmp_path, plain, "plain.toml"), tmp_path / "plain", total_timesteps=256, progress=False)
+    assert scalar_values(result.log_dir, "rollout/shaped_return") == []
+    np.testing.assert_allclose(
+        scalar_values(result.log_dir, "mission/return"), scalar_values(result.log_dir, "rollout/ep_rew_mean"), rtol=1e-6
+    )
