@@ -250,3 +250,36 @@ def test_version_history_records_the_burn_relocation_fix(env_id):
     unreleased = changelog[changelog.index("## [Unreleased]") :]
     fixed = unreleased[unreleased.index("### Fixed") :]
     assert "2026-12-03 (the burn relocation fix)" in fixed and "bumps the id's" in fixed
+
+
+# --------------------------------------------------------------------------------------
+# Pickling carries the state, not the curves' table (which the process caches)
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_a_reset_env_pickles_small_and_continues_identically(env_id):
+    import copy
+    import pickle
+
+    from orbit_env.decay.curves import universal_curves
+
+    env = gym.make(env_id)
+    env.reset(seed=4)
+    actions = [env.action_space.sample() for _ in range(30)]
+    for action in actions[:10]:
+        env.step(action)
+    data = pickle.dumps(env.unwrapped)
+    assert len(data) < 20_000, len(data)  # was 19.7 MB: the curves' table through the task's cache
+    twin = pickle.loads(data)
+    assert twin.task.curves is universal_curves()  # rebuilt from the process's one table
+    deep = copy.deepcopy(env.unwrapped)
+    for action in actions[10:]:
+        a, b, c = env.unwrapped.step(action), twin.step(action), deep.step(action)
+        np.testing.assert_array_equal(a[0], b[0])
+        np.testing.assert_array_equal(a[0], c[0])
+        assert a[1:] == b[1:] == c[1:]
+    vec = gym.make_vec(env_id, num_envs=64, vectorization_mode="vector_entry_point")
+    vec.reset(seed=4)
+    vec.step(vec.action_space.sample())
+    assert len(pickle.dumps(vec.unwrapped)) < 200_000  # 64 satellites' rows, no table

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
 from typing import Any, NamedTuple
 
@@ -156,6 +156,11 @@ class Task:
         if not isinstance(self.density, DensityConfig):
             raise ValueError(f"density={self.density!r} is invalid; allowed: a DensityConfig")
         object.__setattr__(self, "continuous", bool(self.continuous))
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The fields only: the cached properties (the curves' table, 20 MB) rebuild from the
+        # process's cache (universal_curves()) on first use, so a pickled env carries its state alone.
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     @classmethod
     def of(
