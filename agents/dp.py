@@ -2,90 +2,19 @@
 
 SI units inside (m, kg, s, m/s); values and rewards in days, as the env's reward.
 
-State. The env's state is a point on the universal curves (label mu, tau), the
-mass and the steps left. The grid uses three coordinates of it:
+The grid spans three coordinates of the env's state: the curve label mu (spaced in proportion to
+the label change of the smallest burn), the lifetime left in steps n = nu / (K g c s) (a coast
+moves n to n - 1 exactly) and the delta-v left (burns land on its levels). A satellite that
+outlives the k steps left coasts, its value the exact sum of the coasts' days, so only the states
+with n <= k decide and are stored. The env's own task model gives each action's successor and
+reward once, as a sparse interpolation matrix P_a and a vector r_a; then
+V_k = max_a (r_a + P_a V_{k-1}), V_0 = 0, stored compressed (`orbit_env.agents.stage_values`) and
+kept in the disk cache (`orbit_env.cache`). `DPPolicy` acts by the same one-step look-ahead from
+the state recovered from the observation; ``DPPolicy(rollout=2)`` is the rollout policy on it
+(`rollout_returns`).
 
-* mu, the curve's label. A perigee burn moves an orbit across the curves by an
-  amount that shrinks by two orders of magnitude from nearly circular to
-  elongated orbits: at half the horizon's life, 10 m/s moves mu by 0.61 at
-  mu = -13 (431 x 464 km), by 0.014 at -10 (285 x 1032 km) and by 0.0046 at
-  -9.2 (234 x 2332 km). The value changes on that scale, as it is a maximum
-  over plans of discrete burns, and a grid coarser than it is optimistic: a
-  burn's landing point between labels is valued as if the satellite could
-  follow both neighbours' plans, and the maximum over actions picks those
-  errors up stage after stage. So the labels are spaced in proportion to the
-  label change of the smallest burn (at the wet mass and ``LABEL_REFERENCE_LIFE``
-  of the horizon) or to ``LABEL_MAX_SPACING`` where that is less, from ``MU_LOW``
-  up to where that orbit's apogee reaches ``LABEL_FINE_APOGEE`` of the 4000 km cap;
-  above, where only orbits with very low perigees lie and no burn pays (in 1000
-  evaluation episodes the DP policy, the greedy look-ahead and PPO burn below
-  mu = -9.07), the spacing grows geometrically up to the most elongated
-  reachable orbit. Below ``MU_LOW``
-  (e < 1e-7 at re-entry) the orbits are circular to within metres and carry the
-  same lifetime (see `orbit_env.decay.curves`): the value is clamped.
-* n = nu / (K g c s), the lifetime left in steps at the current mass: a coast of
-  one step moves it from n to n - 1 exactly, so with ``life_per_step`` levels per
-  unit of n up to the horizon + 1 (and a geometric tail above, where every orbit
-  outlives the mission) coasting needs no interpolation.
-* the delta-v left, anchored at the full tank and spaced by the greatest common
-  divisor of the burn sizes over ``dv_per_quantum``, plus 0: every burn from a
-  grid level lands on a grid level unless the 4000 km apogee cap cuts it.
-
-A satellite that outlives the k steps left by coasting (n >= k) coasts: a burn
-would buy days only through a longer period, at most c0 day per m/s and step
-left (c0 = K max dP/d(dv) over the curves' domain / day = 8.2e-4), which is
-below the propellant's cost for k < cost / c0 (all 365 stages of the default
-config: 0.30 < 0.4 day per m/s at k = 365). Its value is the exact sum of the
-coasts' days: a difference of cumulative sums on the life levels, the drop of
-the curves' W in the tail. So only the states with n <= k decide: they are the
-only ones stored (half of the grid over the stages), the backward induction
-touches only them, and states that outlive the mission get exact values instead
-of interpolated coasts through the tail. The stages beyond cost / c0 (cheap
-propellant, long missions) decide on every state.
-
-Only a burn's landing point in (mu, n) is interpolated (multilinearly). The
-transitions are the env's own functions on whole arrays of grid states:
-``perigee_burn`` at the heights of ``curves.at``, ``curves.locate`` of the new
-orbit, and ``coast``; reward = days - cost * dv, re-entered states are worth 0.
-For every action the successor and reward are computed once (in chunks, so the
-curves' tables stay in cache), stored as a scipy.sparse interpolation matrix P_a
-and a vector r_a, and then V_k = max_a (r_a + P_a V_{k-1}) on the deciding
-states of stage k, for k = 1..horizon, V_0 = 0, in float32; the values are
-stored as uint16 in steps of 0.01 day, each stage compressed as its increments
-over the stage before (`orbit_env.agents.stage_values`: 825 MB of values in 96 MB
-on the default grid), and the solution is kept in the disk cache
-(`orbit_env.cache`), so it is solved again only when its inputs change. The policy acts by the same one-step
-look-ahead from the state recovered from the observation: argmax_a r_a(s) +
-V_{k-1}(successor), with V_{k-1} interpolated, or the exact sum of the coasts'
-days where the successor outlives the mission. ``DPPolicy(rollout=2)`` is the rollout
-policy on that one (`rollout_returns`): early decisions taken by playing the candidates
-and the base policy to the end in the task model, exact, with no interpolation.
-
-Grid refinement on the 200 evaluation episodes of ``orbit-env evaluate``
-(seed 12345; default config, density scale 1): "value" is the mean of
-`DPSolution.value` at the start states, "realized" the mean return of
-`DPPolicy` in the env, d = value - realized per episode, "greedy
-ahead" the worst episode's lead of the greedy look-ahead over the DP policy.
-Solve times on one core of a 2-core machine with a PPO training on the other;
-"memory" is the solving process' peak.
-
-| grid | states | solve [s] | memory [GB] | value | realized | mean abs(d) | worst abs(d) | greedy ahead |
-|---|---|---|---|---|---|---|---|---|
-| 32, 1, 1 | 400 384 | 3.2 | 0.36 | 265.287 | 264.020 | 1.29 | 25.6 | 22.2 |
-| 64, 1, 1 | 800 768 | 6.3 | 0.61 | 265.258 | 264.719 | 0.57 | 13.0 | 11.5 |
-| 96, 1, 1 | 1 201 152 | 9.1 | 0.84 | 265.233 | 264.998 | 0.26 | 5.5 | 3.6 |
-| 128, 1, 1 | 1 601 536 | 12.6 | 1.08 | 265.218 | 265.077 | 0.16 | 2.9 | 2.6 |
-| 160, 1, 1 | 2 001 920 | 16.3 | 1.31 | 265.210 | 265.112 | 0.13 | 2.7 | 1.2 |
-| 192, 1, 1 | 2 402 304 | 19.6 | 1.50 | 265.206 | 265.133 | 0.10 | 1.9 | 1.1 |
-| 256, 1, 1 | 3 203 072 | 26.4 | 1.96 | 265.196 | 265.154 | 0.07 | 1.8 | 1.1 |
-| 192, 1, 2 | 4 654 464 | 38.7 | 2.76 | 265.206 | 265.133 | 0.10 | 1.9 | 1.1 |
-| 192, 2, 1 | 4 651 008 | 41.9 | 2.83 | 265.203 | 265.141 | 0.09 | 1.5 | 0.8 |
-
-The value moves by less than 0.04% from 32 labels on, the realized return
-converges to it (0.03% below at 192 labels). Halving the delta-v spacing
-changes nothing (the burns land on its levels); halving the life spacing halves
-the worst episodes' errors, at twice the cost. The default grid is (192, 1, 1).
-See docs/dp.md for the baselines and the previous version's numbers.
+The method, the grid refinement, the storage, the certificate and their measurements are in the
+documentation's page on the DP (docs/dp.md).
 """
 
 from __future__ import annotations

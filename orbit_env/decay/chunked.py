@@ -1,60 +1,19 @@
 """Decay under solar activity that changes over the lifetime, on the universal curves. SI units.
 
-The universal curves (`orbit_env.decay.curves`) belong to one fixed density profile.
-NRLMSIS's profile changes with F10.7, Ap and the season, over days to years, so a
-decay that spans a solar cycle cannot follow one family of curves. We step the
-satellites through time in chunks (``chunk_days``, default 20 days); in each chunk
+The universal curves (`orbit_env.decay.curves`) belong to one fixed density profile; NRLMSIS's
+changes with F10.7, Ap and the season. The satellites step through time in chunks
+(``chunk_days``, default 20 days). In each, the curves are those of a *binned* profile (the
+chunk's 81-day F10.7 in steps of ``bin_step`` in ln F10.7, its Ap on a coarse logarithmic grid,
+year-averaged; each bin built once and cached), and what the bin leaves out (every day's
+indices, the season) is a density multiplier s: the chunk's mean of the daily densities over the
+bin's, taken over the orbit as drag weights it (`orbit_ratio`; near re-entry from the averaged
+equations' rates, `SolarDecayModel.weight_of`). The satellite moves along its curve by the
+chunk's time (W = Int P dnu falls by dt g c s); near re-entry a chunk goes a day, then a quarter
+day, at a time (`FINE_CHUNKS`, `FINISH_STEP_DAYS`, `LAST_DAYS`). Satellites are re-located on the
+curves only when the bin changes; everything is vectorized over satellites.
 
-1. the curves are those of a *binned* profile: NRLMSIS at the chunk's mean 81-day
-   F10.7 rounded to a step of ``bin_step`` in ln F10.7 (default 0.1, i.e. 10%),
-   the chunk's mean Ap rounded to a coarse logarithmic grid, averaged over the
-   year. A decade-long lifetime visits a handful of bins, each built once
-   (~0.9 s) and cached;
-2. what the bin leaves out (the exact indices of every day, the season) is a
-   density multiplier s: the chunk's mean over its days of the orbit-averaged
-   NRLMSIS density, each day with its own F10.7, 81-day mean, Ap and day of the
-   year, divided by the bin's density. Densities are averaged, not indices:
-   NRLMSIS responds to Ap concavely, and a chunk's mean Ap overstates the density
-   after storms (by 1.5% in lifetime, measured). The ratio r(h) is tabulated every
-   50 km with 6 x 6 latitude and local-time nodes (numerator and denominator
-   alike, so the coarser sampling cancels);
-3. the ratio is taken over the orbit as drag weights it, not at the perigee alone
-   (`orbit_ratio`): with the bin's density and r locally exponential about the
-   perigee (log-slopes -1/H and beta), King-Hele's orbit average of drag gives
-   s = r(h_p) B((1/H - beta) a e) / B(a e / H), B(x) = e^-x (I0(x) + 2 e I1(x)).
-   A circular orbit takes r(h_p) itself; an eccentric one feels the air above
-   its perigee, where a storm heats the thermosphere more and the season changes
-   the profile's shape. Near re-entry (step 5), where short lives are decided,
-   orbits wider than a e / H = `AVERAGED_MIN_X` take s from the averaged equations
-   themselves, weighted by what the life left depends on: the orbit moves along the
-   bin's curve, where W (below) is the life left, so s is dW/dt under the chunk's
-   profile over dW/dt under the bin's, (W_p p' + W_e e') / (W_p p'_bin + W_e e'_bin),
-   with the rates p', e' of the averaged equations and the gradient of W on the
-   bin's curves (`SolarDecayModel.weight_of`). A ratio of dp/dnu alone moves the
-   perigee at the chunk's rate but not the eccentricity, which the season's change
-   of the profile's shape moves differently: lives of 20-40 days on orbits 120 km
-   wide came out up to -0.58% off the daily reference, and within 0.22% with the
-   gradient's weights (docs/validation-modern.md). The decay rate is linear in
-   density, so what is left is the drift off the bin's curve, second order;
-4. the satellite moves along its curve by the chunk's time: W = Int P dnu falls by
-   dt g c s (``orbit_env.decay.averaged``), solved for nu by Newton's method with
-   dW/dnu = P (the Keplerian period). If W left is smaller, it re-enters within
-   the chunk;
-5. near re-entry (less than `FINE_CHUNKS` chunks of decay left at the chunk's
-   rate) a chunk goes one day at a time (`FINISH_STEP_DAYS`), each day with the
-   density multiplier at that day's orbit of the profile at the day's middle (the
-   daily profiles' logarithms interpolated in time, as the reference does), and the
-   last `LAST_DAYS` days, where the perigee falls tens of km a day, in quarter days
-   (`LAST_STEPS`), so the last weeks are resolved (and recorded) day by day. The
-   days' ratios come from one NRLMSIS call per chunk. With each day's indices held
-   over the day and one step a day, lives of 10-20 days came out up to 0.81% off
-   the daily reference (9 of 36 above 0.5%), and within 0.35% so
-   (docs/validation-modern.md).
-
-Satellites are re-located on the curves only when the bin changes. Everything is
-vectorized over satellites. The measured effect of the chunk length and the bin
-step against a day-by-day integration of the averaged equations
-(`integrate_reference`) is in ``docs/validation-modern.md``.
+Why each choice, and its measured effect against a day-by-day integration of the averaged
+equations (`integrate_reference`): docs/validation-modern/solar-activity.md.
 """
 
 from __future__ import annotations
