@@ -1,14 +1,14 @@
-"""The optimum of the known-density task by backward induction on a grid.
+r"""The optimum of the known-density task by backward induction on a grid.
 
 SI units inside (m, kg, s, m/s); values and rewards in days, as the env's reward.
 
 The grid spans three coordinates of the env's state: the curve label mu (spaced in proportion to
-the label change of the smallest burn), the lifetime left in steps n = nu / (K g c s) (a coast
-moves n to n - 1 exactly) and the delta-v left (burns land on its levels). A satellite that
-outlives the k steps left coasts, its value the exact sum of the coasts' days, so only the states
-with n <= k decide and are stored. The env's own task model gives each action's successor and
-reward once, as a sparse interpolation matrix P_a and a vector r_a; then
-V_k = max_a (r_a + P_a V_{k-1}), V_0 = 0, stored compressed (`orbit_env.agents.stage_values`) and
+the label change of the smallest burn), the lifetime left in steps $n = \nu / (K g c s)$ (a coast
+moves $n$ to $n - 1$ exactly) and the delta-v left (burns land on its levels). A satellite that
+outlives the $k$ steps left coasts, its value the exact sum of the coasts' days, so only the states
+with $n \le k$ decide and are stored. The env's own task model gives each action's successor and
+reward once, as a sparse interpolation matrix $P_a$ and a vector $r_a$; then
+$V_k = \max_a (r_a + P_a V_{k-1})$, $V_0 = 0$, stored compressed (`orbit_env.agents.stage_values`) and
 kept in the disk cache (`orbit_env.cache`). `DPPolicy` acts by the same one-step look-ahead from
 the state recovered from the observation; ``DPPolicy(rollout=2)`` is the rollout policy on it
 (`rollout_returns`).

@@ -1,8 +1,8 @@
 """The DP's values of every stage, compressed: each stage as the change from the stage before.
 
-A stage k holds V_k on the decision states of stage k, a prefix of the state
+A stage $k$ holds $V_k$ on the decision states of stage k, a prefix of the state
 vector that grows by one life level per stage (`orbit_env.agents.dp`), as uint16
-in steps of the values' quantum. V_k differs little from V_{k-1} on their common
+in steps of the values' quantum. $V_k$ differs little from $V_{k-1}$ on their common
 prefix: one more step left adds at most about a day (100 quanta), and nothing
 where the satellite cannot live to the mission's end. So a stage is stored as
 its increments over the stage before, as uint8 (the new life level's values as
@@ -16,8 +16,8 @@ stage 0.2 s on one core, against 4.0 s and 1.4 s for zlib at its fastest level
 ``KEYFRAME_STAGES`` stages, the default task's solution takes 122 MB.
 
 A stage is read from a neighbour read just before it, by adding its increments
-to the stage below or taking the stage above's increments away (V_{k-1} = V_k -
-(V_k - V_{k-1}), exact in integers), or else from the keyframe at or below it.
+to the stage below or taking the stage above's increments away
+($V_{k-1} = V_k - (V_k - V_{k-1})$, exact in integers), or else from the keyframe at or below it.
 Only the last two stages read are kept decoded (about 10 MB on the default grid,
 whatever the number of solutions held, as the oracle's nine), so the DP policy,
 which reads one stage a step in descending order (two with a look-ahead of two),
