@@ -576,7 +576,7 @@ def configs(draw):
     high = draw(st.floats(low, 1100.0, **finite))
     return OrbitRaisingConfig(
         drag_coefficient=draw(st.floats(1.0, 3.0, **finite)),
-        area_m2=draw(st.floats(0.01, 20.0, **finite)),
+        area_m2=draw(st.floats(0.05, 20.0, **finite)),  # loads within 1e5 kg/m^2
         dry_mass_kg=dry,
         propellant_mass_kg=draw(st.floats(0.0, 0.5 * dry, **finite)),
         isp_s=draw(st.floats(50.0, 450.0, **finite)),
@@ -689,7 +689,7 @@ def test_invalid_vector_actions_raise_value_errors():
         ),
         ({"perigee_km": float("nan")}, r"reset option perigee_km=nan must be finite"),
         ({"propellant_mass_kg": -1.0}, r"propellant_mass_kg=-1 is out of range; allowed: at least 0 kg"),
-        ({"dry_mass_kg": 0.0}, r"dry_mass_kg=0 is out of range; allowed: above 0 kg"),
+        ({"dry_mass_kg": 0.0}, r"dry_mass_kg=0 is out of range; allowed: above 0 and at most 1000000 kg"),
         ({"propellant_mass_kg": 1e4}, r"delta-v \(isp_s, propellant_mass_kg, dry_mass_kg\); allowed: up to 3000"),
         ({"density_scale": -2.0}, r"density_scale=-2 is out of range; allowed: above 0"),
         ({"apogee_km": "high"}, r"reset option apogee_km='high' must be a number"),
@@ -716,7 +716,7 @@ def test_reset_options_pin_the_orbit_and_the_satellite():
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"area_m2": -1.0}, r"area_m2=-1 is out of range; allowed: above 0 m\^2"),
+        ({"area_m2": -1.0}, r"area_m2=-1 is out of range; allowed: above 0 and at most 100000 m\^2"),
         ({"burn_sizes_m_s": ()}, r"burn_sizes_m_s=\(\) is invalid"),
         ({"burn_sizes_m_s": (0.0, -5.0)}, r"burn_sizes_m_s\[1\]=-5 is out of range; allowed: 0 to 3000 m/s"),
         ({"horizon_steps": 0}, r"horizon_steps=0 is out of range; allowed: an integer at least 1"),
@@ -738,6 +738,42 @@ def test_reset_options_pin_the_orbit_and_the_satellite():
 def test_invalid_configs_raise_value_errors_naming_the_value(kwargs, message):
     with pytest.raises(ValueError, match=message):
         OrbitRaisingConfig(**kwargs)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        (
+            {"drag_coefficient": 50.0},
+            r"drag_coefficient=50 is out of range; allowed: above 0 and at most 10 \(free-molecular",
+        ),
+        ({"area_m2": 2e5}, r"area_m2=200000 is out of range; allowed: above 0 and at most 100000 m\^2"),
+        ({"dry_mass_kg": 2e6}, r"dry_mass_kg=2000000 is out of range; allowed: above 0 and at most 1000000 kg"),
+        (
+            {"dry_mass_kg": 1e6, "propellant_mass_kg": 1e5, "area_m2": 1e3},
+            r"dry_mass_kg \+ propellant_mass_kg=1100000 is out of range; allowed: at most 1000000 kg",
+        ),
+        (
+            {"dry_mass_kg": 0.5, "propellant_mass_kg": 0.0, "area_m2": 100.0},
+            r"dry_mass_kg / area_m2=0.005 is out of range; allowed: at least 0.01 kg/m\^2",
+        ),
+        (
+            {"dry_mass_kg": 1000.0, "area_m2": 0.001},
+            r"\(dry_mass_kg \+ propellant_mass_kg\) / area_m2=.* is out of range; allowed: at most 100000 kg/m\^2",
+        ),
+    ],
+)
+def test_the_envs_satellite_has_the_lifetime_apis_bounds(kwargs, message):
+    # One set of bounds (orbit_env.physics.satellite_bounds) for the environments and `Satellite`.
+    with pytest.raises(ValueError, match=message):
+        make("OrbitRaising-v0", **kwargs)
+    with pytest.raises(ValueError, match=message):
+        make_vec("OrbitRaising-v0", 2, **kwargs)
+    with pytest.raises(ValueError, match=message):
+        make_vec("OrbitRaising-v0", 2).reset(seed=0, options=kwargs)
+    if set(kwargs) <= {"drag_coefficient", "area_m2"}:
+        with pytest.raises(ValueError, match=message):
+            orbit_env.Satellite(**kwargs)
 
 
 def test_invalid_density_and_env_arguments():

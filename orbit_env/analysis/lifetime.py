@@ -30,6 +30,15 @@ from orbit_env.decay.curves import (
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
 from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
+from orbit_env.physics.satellite_bounds import (
+    AREA_RANGE_M2,
+    DRAG_COEFFICIENT_RANGE,
+    MASS_PER_AREA_RANGE_KG_M2,
+    MASS_RANGE_KG,
+)
+from orbit_env.physics.satellite_bounds import (
+    DRAG_PARAMETER_RANGE_M2_KG as DRAG_PARAMETER_RANGE_M2_KG,
+)
 
 FloatArray = NDArray[np.float64]
 Method = Literal["averaged", "curves", "direct"]
@@ -40,17 +49,6 @@ PAPER_SPHERE_DIAMETER_M = 0.5
 PAPER_SPHERE_MASS_KG = 10.0
 PAPER_DRAG_COEFFICIENT = 2.0
 
-#: Bounds of a satellite's drag properties, and why. Outside them a lifetime is a number of
-#: 300 digits or of 1e-300 days: no body in orbit has such values.
-DRAG_COEFFICIENT_RANGE = (0.0, 10.0, "free-molecular drag coefficients are 2 to 4 for any shape")
-MASS_RANGE_KG = (0.0, 1e6, "the largest satellite, the ISS, is 4.2e5 kg")
-AREA_RANGE_M2 = (0.0, 1e5, "a 300 m drag sail; the ISS spans about 2500 m^2")
-MASS_PER_AREA_RANGE_KG_M2 = (
-    0.01,
-    1e5,
-    "from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2",
-)
-DRAG_PARAMETER_RANGE_M2_KG = (1e-5, 1e3, "c_x A / m within the bounds of c_x and of mass / area")
 #: Longest lifetime reported [years]; beyond it a number would claim more than any atmosphere
 #: model (or the solar cycles it averages) can say.
 MAX_LIFETIME_YEARS = 1e6

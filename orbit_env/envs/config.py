@@ -20,6 +20,12 @@ from numpy.typing import ArrayLike
 from orbit_env.checks import check_array, check_int, check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
+from orbit_env.physics.satellite_bounds import (
+    AREA_RANGE_M2,
+    DRAG_COEFFICIENT_RANGE,
+    MASS_PER_AREA_RANGE_KG_M2,
+    MASS_RANGE_KG,
+)
 
 #: Largest delta-v a satellite may carry [m/s]. More is beyond escape from low orbit,
 #: never an orbit-raising budget; the bound keeps the observation space bounded.
@@ -195,14 +201,29 @@ def validate_satellite(
     propellant_mass_kg: ArrayLike,
     isp_s: ArrayLike,
 ) -> None:
-    """Check a satellite (scalars or arrays); ValueError names the first bad value."""
+    """Check a satellite (scalars or arrays); ValueError names the first bad value and its range.
+
+    The drag properties within the bounds of `orbit_env.physics.satellite_bounds`, the ones
+    `orbit_env.analysis.lifetime.Satellite` checks: the mass at both ends of the mission (dry
+    and wet) and the load of both.
+    """
     positive = {"low": 0.0, "low_inclusive": False}
-    check_array(drag_coefficient, "drag_coefficient", **positive)
-    check_array(area_m2, "area_m2", unit="m^2", **positive)
-    check_array(dry_mass_kg, "dry_mass_kg", unit="kg", **positive)
+    for value, name, unit, (low, high, why) in (
+        (drag_coefficient, "drag_coefficient", "", DRAG_COEFFICIENT_RANGE),
+        (area_m2, "area_m2", "m^2", AREA_RANGE_M2),
+        (dry_mass_kg, "dry_mass_kg", "kg", MASS_RANGE_KG),
+    ):
+        check_array(value, name, unit=unit, low=low, high=high, low_inclusive=False, why=why)
     check_array(isp_s, "isp_s", unit="s", **positive)
     propellant = check_array(propellant_mass_kg, "propellant_mass_kg", unit="kg", low=0.0)
     dry = np.asarray(dry_mass_kg, dtype=np.float64)
+    wet = dry + propellant
+    low, high, why = MASS_RANGE_KG
+    check_array(wet, "dry_mass_kg + propellant_mass_kg", unit="kg", high=high, why=why)
+    low, high, why = MASS_PER_AREA_RANGE_KG_M2
+    area = np.asarray(area_m2, dtype=np.float64)
+    check_array(dry / area, "dry_mass_kg / area_m2", unit="kg/m^2", low=low, why=why)
+    check_array(wet / area, "(dry_mass_kg + propellant_mass_kg) / area_m2", unit="kg/m^2", high=high, why=why)
     capacity = np.asarray(isp_s, dtype=np.float64) * G0_M_S2 * np.log1p(propellant / dry)
     bad = capacity > MAX_DV_CAPACITY_M_S
     if bad.any():
