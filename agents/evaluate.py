@@ -32,8 +32,17 @@ EVAL_SEED = 12345
 EVAL_EPISODES = 1000
 #: Episodes whose returns differ by less than this [days] count as ties in the paired comparison.
 TIE_DAYS = 0.01
-#: Order of the policies in tables and JSON.
-POLICY_ORDER = ("never", "all_at_once", "apogee_threshold", "greedy", "dp", "ppo", "a2c", "dqn", "sac", "td3")
+#: The Stable-Baselines3 algorithms ``orbit-env evaluate --model`` loads.
+ALGORITHMS = ("ppo", "a2c", "dqn", "sac", "td3")
+
+
+def policy_order() -> tuple[str, ...]:
+    """The order of the policies in tables and JSON: `HAND_CODED`'s, then the DP, then `ALGORITHMS`.
+
+    Read from those declarations when called, so a policy added to `HAND_CODED` is scored
+    and listed with no second list to update.
+    """
+    return (*HAND_CODED, "dp", *ALGORITHMS)
 
 
 class Predictor(Protocol):
@@ -150,7 +159,7 @@ def task_of(env_id: str) -> Any:
 
 
 def hand_coded_policies(env_id: str) -> dict[str, Predictor]:
-    """The four hand-coded baselines, set up for ``env_id``'s config and action space."""
+    """The hand-coded baselines (`HAND_CODED`), set up for ``env_id``'s config and action space."""
     base = task_of(env_id)
     return {name: cls(base.config, base.density, base.continuous) for name, cls in HAND_CODED.items()}
 
@@ -235,10 +244,6 @@ SHIPPED_MODELS = {
     "OrbitRaisingUncertain-v0": "ppo_orbit_raising_uncertain.zip",
     "OrbitRaisingContinuous-v0": "ppo_orbit_raising_continuous.zip",
 }
-
-
-#: The Stable-Baselines3 algorithms ``orbit-env evaluate --model`` loads.
-ALGORITHMS = ("ppo", "a2c", "dqn", "sac", "td3")
 
 
 def model_algorithm(path: str | Path) -> str:
@@ -376,7 +381,7 @@ def all_policies(
     dp_lookahead: int = 1,
     dp_rollout: bool = False,
 ) -> dict[str, Predictor]:
-    """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in `POLICY_ORDER`.
+    """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in `policy_order`.
 
     The learned agent (``model_path``, or the shipped one) is loaded and checked
     first (`load_model`), before the DP's solve; its row is named by its
@@ -391,7 +396,7 @@ def all_policies(
         policies["dp"] = dp_policy(env_id, dp_lookahead, dp_rollout)
     if learned is not None:
         policies[learned[0]] = learned[1]
-    return {name: policies[name] for name in POLICY_ORDER if name in policies}
+    return {name: policies[name] for name in policy_order() if name in policies}
 
 
 class ContinuousFromDiscrete:

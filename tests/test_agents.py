@@ -7,15 +7,17 @@ import numpy as np
 import pytest
 
 import orbit_env  # noqa: F401  (registers the environments)
+import orbit_env.agents.evaluate as evaluate_module
 from orbit_env.agents.evaluate import (
     EVAL_SEED,
     Episodes,
+    all_policies,
     hand_coded_policies,
     paired_difference,
     run_episodes,
     summarize,
 )
-from orbit_env.agents.policies import AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
+from orbit_env.agents.policies import HAND_CODED, AllAtOnce, ApogeeThreshold, Greedy, NeverBurn
 from orbit_env.cli import main
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig
@@ -82,6 +84,21 @@ def test_policies_answer_sb3_predict_single_and_batched(cls):
     assert box.contains(continuous.predict(obs)[0])
     with pytest.raises(ValueError, match="shape"):
         policy.predict(np.zeros(5))
+
+
+class _Twice(NeverBurn):
+    """A policy that is only declared in `HAND_CODED` (by the test)."""
+
+    name = "twice"
+
+
+def test_every_hand_coded_policy_is_evaluated_in_its_declared_order(monkeypatch):
+    # A new hand-coded policy is declared once, in HAND_CODED; `evaluate` scores and lists it.
+    monkeypatch.setitem(HAND_CODED, _Twice.name, _Twice)
+    monkeypatch.setattr(evaluate_module, "load_model", lambda *args: None)  # no learned agent
+    policies = all_policies("OrbitRaising-v0", include_dp=False)
+    assert list(policies) == list(HAND_CODED)
+    assert isinstance(policies["twice"], _Twice)
 
 
 def test_apogee_threshold_burns_only_below_threshold():
