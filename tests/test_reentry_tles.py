@@ -2,7 +2,7 @@
 
 Every line must carry a valid mod-10 checksum, every set must parse and propagate at its epoch with sgp4, the
 catalogue numbers must match objects.csv, the re-entry dates must parse, every object must have at least one set
-between 7 days and 3 years before re-entry, and provenance.csv must account for every set.
+between 7 days and 3 years before re-entry, and provenance.csv (with sources.csv) must name the source of every set.
 """
 
 import csv
@@ -130,11 +130,17 @@ def test_row_fields(row):
 
 
 def test_provenance_accounts_for_every_set():
+    with (DATA / "sources.csv").open(newline="", encoding="utf-8") as f:
+        sources = {row["source_id"]: row for row in csv.DictReader(f)}
+    for row in sources.values():
+        assert row["repo"].count("/") == 1 and row["path"], row
+        assert len(row["commit"]) == 40 and int(row["commit"], 16) >= 0, row
     with (DATA / "provenance.csv").open(newline="", encoding="utf-8") as f:
         prov = list(csv.DictReader(f))
-    counts: dict[str, int] = {}
+    listed: dict[str, list[str]] = {}
     for p in prov:
-        assert p["repo"] and p["path"] and len(p["commit"]) == 40, p
-        counts[p["norad"]] = counts.get(p["norad"], 0) + int(p["n_sets"])
+        assert p["source_id"] in sources, p
+        listed.setdefault(p["norad"], []).append(p["epoch_field"])
     for norad in IDS:
-        assert counts.get(norad) == len(read_sets(tle_file(norad))), norad
+        in_file = [l1[18:32] for l1, _ in read_sets(tle_file(norad))]
+        assert listed.get(norad) == in_file, norad
