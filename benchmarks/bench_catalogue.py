@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from orbit_env import cache
+from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.decay import chunked
@@ -100,12 +101,10 @@ def main() -> None:
     cache.disable()
     if args.epoch:
         activity, sun = load_record(), f"the solar record from {args.epoch}"
-        scenario = Scenario(
-            "msis", activity=activity, epoch_days=unix_days(args.epoch), rotating_atmosphere=args.rotating
-        )
+        scenario = Scenario(MsisAir(activity, unix_days(args.epoch)), rotating_atmosphere=args.rotating)
     else:
         sun = "NRLMSIS F10.7 150, Ap 15"
-        scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0), rotating_atmosphere=args.rotating)
+        scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)), rotating_atmosphere=args.rotating)
     air = "co-rotating" if args.rotating else "still"
     checked = f", the {args.rule:g}-year rule checked" if args.rule else ""
     print(f"{args.rows} rows a catalogue, {sun}, {air} air{checked}, cold, median of {args.repeats}")

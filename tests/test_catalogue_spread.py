@@ -5,6 +5,7 @@ import pytest
 
 pytest.importorskip("pymsis")
 
+from orbit_env.analysis.air import MsisAir, PaperAir
 from orbit_env.analysis.catalogue import (
     PATH_NODES,
     SPREAD_MAX_SPAN_M,
@@ -40,7 +41,7 @@ def days_of(scenario, orbits, **options):
 
 @pytest.mark.parametrize("rotating", [False, True])
 def test_one_family_and_a_ratio_match_a_family_per_inclination(rotating):
-    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0), rotating_atmosphere=rotating)
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)), rotating_atmosphere=rotating)
     orbits = catalogue(300, SPREAD_MAX_SPAN_M / 1e3)
     one, families_one = days_of(scenario, orbits)
     exact, families_exact = days_of(scenario, orbits, exact_groups=True)
@@ -60,7 +61,7 @@ def test_one_family_and_a_ratio_match_a_family_per_inclination(rotating):
 def test_wide_orbits_on_one_family_match_a_family_per_inclination(rotating):
     # Orbits 100-1500 km wide: the multiplier is the ratio of the rates at which the life left falls
     # (catalogue._life_rate_ratio); one density multiplier at the perigee is off by more than the tolerance.
-    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0), rotating_atmosphere=rotating)
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)), rotating_atmosphere=rotating)
     hp, ha, c, inclination = catalogue(300, 100.0, seed=4)
     ha = hp + np.random.default_rng(5).uniform(SPREAD_MAX_SPAN_M, 1500e3, hp.size)
     one, families = days_of(scenario, (hp, ha, c, inclination))
@@ -77,12 +78,12 @@ def test_wide_orbits_on_one_family_match_a_family_per_inclination(rotating):
 
 
 def test_the_ratio_is_zero_at_the_reference_and_grows_with_the_distance_from_it():
-    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0))
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
     log_ratio = inclination_log_ratio(scenario, 51.0, np.array([51.0, 60.0, 90.0]))
     assert log_ratio[0] == pytest.approx(0.0, abs=1e-12)
     assert np.all(np.abs(log_ratio[1]) <= np.abs(log_ratio[2]) + 1e-12)
     # Still air in the paper's law does not depend on the inclination.
-    assert not np.any(inclination_log_ratio(Scenario("paper"), 51.0, np.array([0.0, 98.0])))
+    assert not np.any(inclination_log_ratio(Scenario(PaperAir()), 51.0, np.array([0.0, 98.0])))
 
 
 def test_the_rule_on_one_family_matches_a_family_per_inclination():
@@ -93,7 +94,7 @@ def test_the_rule_on_one_family_matches_a_family_per_inclination():
     the local density scale height (at most ~70 km at these heights) times 0.005, 0.35 km,
     and the search's own bracket is (perigee - 100 km) / 17^3 < 0.2 km.
     """
-    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0))
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
     hp, ha, c, inclination = catalogue(300, SPREAD_MAX_SPAN_M / 1e3, seed=6)
     rows = [{} for _ in hp]
 
@@ -144,7 +145,7 @@ def test_a_stepped_catalogue_on_one_family_matches_a_family_per_inclination(wide
     from orbit_env.decay.solar import unix_days
     from orbit_env.decay.solar_record import load_record
 
-    scenario = Scenario("msis", activity=load_record(), epoch_days=unix_days("2024-01-01"))
+    scenario = Scenario(MsisAir(load_record(), unix_days("2024-01-01")))
     orbits = stepped_orbits(40, wide)
     one, families_one = days_of(scenario, orbits)
     exact, families_exact = days_of(scenario, orbits, exact_groups=True)
@@ -160,6 +161,6 @@ def test_a_stepped_catalogue_on_one_family_matches_a_family_per_inclination(wide
 
 
 def test_own_inclinations_need_the_time_stepped_path():
-    scenario = Scenario("msis", activity=ConstantActivity(150.0, 150.0, 15.0))
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
     with pytest.raises(ValueError, match="time-stepped"):
         scenario.lifetime_days(400e3, 450e3, 0.01, 51.0, own_inclination_deg=0.0)

@@ -1,7 +1,6 @@
 """Dates on lifetimes (re-entry date, dated history and plot) and lives longer than the propagation."""
 
 import csv
-import functools
 import json
 
 import numpy as np
@@ -9,8 +8,8 @@ import pytest
 
 pytest.importorskip("pymsis")
 
-from orbit_env.analysis import lifetime as lifetime_module
 from orbit_env.cli import main
+from orbit_env.decay import chunked
 from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.solar import unix_days
 
@@ -42,8 +41,10 @@ def test_reentry_date_is_the_epoch_plus_the_lifetime(capsys, tmp_path):
 
 def test_outliving_the_propagation_is_a_result(capsys, monkeypatch):
     # A 0.3-year cap stands in for the 200 years (same code path, a test's time).
-    short = functools.partial(SolarDecayModel, max_years=0.3)
-    monkeypatch.setattr(lifetime_module, "SolarDecayModel", short)
+    def short(*args, **kwargs):
+        return SolarDecayModel(*args, **{**kwargs, "max_years": 0.3})
+
+    monkeypatch.setattr(chunked, "SolarDecayModel", short)
     argv = ["lifetime", "--perigee", "500", "--apogee", "500", *CUBESAT, "--epoch", "2015-05-01"]
     status, out, _ = run(capsys, *argv, "--json")
     result = json.loads(out)

@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.density_fit import Observations, fit_density_scale, read_observations
 from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.scenario import Scenario
@@ -71,7 +72,7 @@ def test_reentry_under_a_time_varying_scenario():
     pytest.importorskip("pymsis")
     from orbit_env.decay.solar import CycleActivity, unix_days
 
-    scenario = Scenario("msis", activity=CycleActivity(), epoch_days=unix_days("2022-01-01"))
+    scenario = Scenario(MsisAir(CycleActivity(), unix_days("2022-01-01")))
     days, _ = scenario.lifetime_days(300e3, 300e3, SATELLITE.drag_parameter_m2_kg, 51.6, density_scale=0.6)
     first = Observations(np.array([0.0]), np.array([300.0]), np.array([300.0]))
     fit = fit_density_scale(

@@ -2,6 +2,7 @@
 
 import pytest
 
+from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.lifetime import Satellite, check_rule, lifetime
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.decay.chunked import SolarDecayModel
@@ -18,7 +19,7 @@ def test_a_dated_gto_has_a_lifetime_and_a_verdict_from_one_computation():
     assert life.reentered and life.method == "averaged"
     # An upper stage in GTO lives for decades: between 10 and 200 years.
     assert 10 * 365.25 < life.days < 200 * 365.25
-    scenario = Scenario(atmosphere="msis", activity=load_record(), epoch_days=unix_days(EPOCH))
+    scenario = Scenario(MsisAir(load_record(), unix_days(EPOCH)))
     check = check_rule(250, 35786, 25, satellite=STAGE, scenario=scenario, inclination_deg=28.5)
     # The verdict's lifetime is the printed one (the same mean air, the same integration).
     assert float(check.lifetime_days[0]) == pytest.approx(life.days, rel=1e-9)

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.disposal import apogee_speed_m_s, check_disposal_rule, perigee_lowering_dv_m_s
 from orbit_env.analysis.lifetime import Satellite, check_rule, lifetime
 from orbit_env.analysis.scenario import Scenario
@@ -140,7 +141,7 @@ def test_rule_on_the_curves_is_consistent_with_lifetime():
 
 
 def test_rule_under_a_solar_cycle(msis):
-    scenario = Scenario("msis", activity=CycleActivity(), epoch_days=unix_days("2024-01-01"))
+    scenario = Scenario(MsisAir(CycleActivity(), unix_days("2024-01-01")))
     check = check_rule(550, 550, 5, satellite=SATELLITE, scenario=scenario, inclination_deg=51.6)
     assert not check.complies[0] and check.dv_m_s[0] > 0
     after = scenario.lifetime_days(check.new_perigee_m, 550e3, SATELLITE.drag_parameter_m2_kg, 51.6)[0][0]

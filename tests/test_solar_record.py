@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from orbit_env.analysis.air import MsisAir
 from orbit_env.cli import build_parser, main
 from orbit_env.cli.lifetime import _scenario
 from orbit_env.cli.orbit_inputs import prepare
@@ -106,7 +107,7 @@ def test_an_epoch_alone_means_nrlmsis_and_the_real_sun():
     args = build_parser().parse_args(["lifetime", "--perigee", "400", "--apogee", "400", "--epoch", "2003-10-01"])
     prepare(args)
     scenario = _scenario(args)
-    assert scenario.atmosphere == "msis" and isinstance(scenario.activity, RecordActivity)
+    assert isinstance(scenario.air, MsisAir) and isinstance(scenario.activity, RecordActivity)
     # The Halloween storms of 2003: Ap 204 on 29 October (CelesTrak's record; a figure widely quoted).
     assert scenario.activity.indices([unix_days("2003-10-29")])[2][0] == pytest.approx(204.0)
     args = build_parser().parse_args(

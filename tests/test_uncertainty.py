@@ -9,6 +9,7 @@ import pytest
 from scipy.stats import norm
 
 from orbit_env.analysis import uncertainty as U
+from orbit_env.analysis.air import MsisAir, PaperAir
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.cli import main
 
@@ -31,7 +32,7 @@ def test_seeded_samples_repeat():
 def test_fixed_profile_percentiles_and_probability_from_the_log_normal():
     # Paper's atmosphere: one lifetime d0 divided by each sample's log-normal factor (exact, Eq. 3.4),
     # so ln(days) ~ N(ln d0, SIGMA^2).
-    scenario = Scenario("paper")
+    scenario = Scenario(PaperAir())
     c = 2.0 * 0.19635 / 10.0
     d0 = float(scenario.lifetime_days(360e3, 800e3, c, 0.0)[0])
     spread = U.lifetime_spread(360e3, 800e3, c, scenario, 0.0, samples=20_000, seed=1)
@@ -57,7 +58,7 @@ def test_solar_interpolation_against_samples_propagated_one_by_one():
     record = load_record()
     # A 250 km cubesat from the end of the observations: a life of weeks, all of it in the forecast.
     start = record.observed_end_days
-    scenario = Scenario("msis", activity=record, epoch_days=start, rotating_atmosphere=True)
+    scenario = Scenario(MsisAir(record, start), rotating_atmosphere=True)
     hp, c = 257e3, 0.0165
     spread = U.lifetime_spread(hp, hp, c, scenario, 51.6, samples=40, seed=3)
     z, density, drag = U.sample_factors(40, 3)
@@ -104,7 +105,7 @@ def test_each_node_propagates_only_its_samples_with_the_same_lifetimes():
     record = load_record()
     # From a month after the last observed day: all of the life in the forecast, which the nodes scale.
     start = record.observed_end_days + 30.0
-    scenario = Scenario("msis", activity=record, epoch_days=start, rotating_atmosphere=True)
+    scenario = Scenario(MsisAir(record, start), rotating_atmosphere=True)
     hp, c, n = 300e3, 0.0165, 60
     spread = U.lifetime_spread(hp, hp, c, scenario, 51.6, samples=n, seed=11)
     z, density, drag = U.sample_factors(n, 11)

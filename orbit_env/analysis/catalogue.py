@@ -373,7 +373,7 @@ def batch_lifetimes(
     complies = np.zeros(n, dtype=bool)
     new_hp = np.full(n, np.nan)
     dv = np.full(n, np.nan)
-    depends_on_inclination = scenario.atmosphere == "msis" or scenario.rotating_atmosphere
+    depends_on_inclination = scenario.depends_on_inclination
     if depends_on_inclination:
         group_of = np.round(inclination_deg / INCLINATION_STEP_DEG) * INCLINATION_STEP_DEG
     else:
@@ -455,33 +455,21 @@ def batch_lifetimes(
 
 
 def inclination_log_ratio(scenario: Scenario, reference_deg: float, inclination_deg: FloatArray) -> FloatArray:
-    """ln(NRLMSIS density at each inclination / at ``reference_deg``) on ``RATIO_HEIGHTS_M``, shape (n, heights).
+    """ln(the air's density at each inclination / at ``reference_deg``) on ``RATIO_HEIGHTS_M``, shape (n, heights).
 
-    Zero for the other atmospheres (they do not depend on the inclination). NRLMSIS is
-    averaged over the year at every ``ANCHOR_STEP_DEG`` spanning the inclinations, in
-    one call, and its logarithm interpolated in inclination by a cubic spline.
+    Zero for an air that does not depend on the inclination. NRLMSIS is averaged over the
+    year at every ``ANCHOR_STEP_DEG`` spanning the inclinations, in one call, and its
+    logarithm interpolated in inclination by a cubic spline.
     """
     inclination = np.asarray(inclination_deg, dtype=np.float64)
     zero = np.zeros((inclination.size, RATIO_HEIGHTS_M.size))
-    if scenario.atmosphere != "msis":
+    if not scenario.air.depends_on_inclination:
         return zero
-    from orbit_env.decay.solar import ConstantActivity
-    from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
-
     anchors = inclination_anchors(inclination, reference_deg)
     if anchors.size < 2:
         return zero
-    solar = scenario.solar
-    assert isinstance(solar, ConstantActivity)
-    rho = mean_density_over_inclinations_kg_m3(
-        RATIO_HEIGHTS_M,
-        solar.f107_sfu,
-        solar.f107a_sfu,
-        solar.ap,
-        anchors,
-        scenario.ascending_node_local_time_h,
-        **RATIO_NODES,  # the chunks' (6 x 6): against 12 x 6, ln ratio within 2e-4 at 150-1200 km
-    )
+    # The chunks' nodes (6 x 6): against 12 x 6, ln ratio within 2e-4 at 150-1200 km.
+    rho = scenario.air.mean_density_over_inclinations_kg_m3(RATIO_HEIGHTS_M, anchors, **RATIO_NODES)
     return np.asarray(inclination_basis(anchors, inclination, reference_deg) @ np.log(rho), dtype=np.float64)
 
 
@@ -552,7 +540,7 @@ def _spread_days(
     else:
         log_value, log_slope = interpolate_rows_with_slope(log_ratio, RATIO_HEIGHTS_M, hp)
         ratio = np.exp(log_value)
-        if scenario.atmosphere == "msis":
+        if scenario.air.depends_on_inclination:
             from orbit_env.decay.chunked import log_density_slope_per_m
             from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
 

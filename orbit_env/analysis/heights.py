@@ -36,11 +36,6 @@ HEIGHT_REFERENCES: tuple[str, ...] = ("equatorial", "sphere")
 EQUATORIAL_OFFSET_KM = (EARTH_EQUATORIAL_RADIUS_M - EARTH_RADIUS_M) / 1e3
 
 
-def default_height_reference(atmosphere: str) -> HeightReference:
-    """The paper's sphere for the paper's atmosphere; the equatorial radius for NRLMSIS and the exponential law."""
-    return "sphere" if atmosphere == "paper" else "equatorial"
-
-
 def offset_km(reference: str) -> float:
     """What to add to a height above ``reference`` for the height above the sphere [km]."""
     if reference not in HEIGHT_REFERENCES:

@@ -13,6 +13,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.analysis.air import Air, MsisAir, PaperAir, ProfileAir
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
 from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density
 from orbit_env.checks import InputError, check_date, check_number
@@ -28,7 +29,7 @@ from orbit_env.decay.curves import (
     universal_curves,
 )
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
-from orbit_env.physics.atmosphere import Atmosphere, PaperAtmosphere
+from orbit_env.physics.atmosphere import Atmosphere, as_atmosphere
 from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
 from orbit_env.physics.satellite_bounds import (
     AREA_RANGE_M2,
@@ -224,12 +225,13 @@ def lifetime(
     apogee_km: float,
     *,
     satellite: Satellite | None = None,
-    method: Method = "averaged",
+    scenario: Scenario | None = None,
+    method: Method | None = None,
+    inclination_deg: float = 0.0,
     rho100_kg_m3: float | None = None,
     density_scale: float = 1.0,
     atmosphere: Atmosphere | None = None,
-    rotating_atmosphere: bool = False,
-    inclination_deg: float = 0.0,
+    rotating_atmosphere: bool | None = None,
     activity: SolarActivity | None = None,
     epoch: str | float | None = None,
     ascending_node_local_time_h: float | None = None,
@@ -237,26 +239,34 @@ def lifetime(
 ) -> LifetimeResult:
     """Lifetime of a satellite from perigee/apogee heights to re-entry (perigee 100 km).
 
+    The air is a `Scenario` (``scenario``), or, as a shorthand, the keywords from
+    ``rho100_kg_m3`` on, which build one (`scenario_from_keywords`); not both.
+
     Args:
         perigee_km: Initial perigee height above the spherical Earth.
         apogee_km: Initial apogee height.
         satellite: Drag properties (default: the paper's 0.5 m, 10 kg sphere, c_x 2).
-        method: ``averaged`` integrates the orbit-averaged equations (reference),
-            ``curves`` interpolates the universal curves (fast), ``direct``
-            integrates the non-averaged equations of motion (slow; a check).
-        rho100_kg_m3: Override the paper atmosphere's density at 100 km.
-        density_scale: Multiply the density profile.
-        atmosphere: Any density model (replaces the paper's; ``rho100_kg_m3``
-            then does not apply).
-        rotating_atmosphere: Let the air co-rotate with the Earth (section 5).
+        scenario: The air and how it is stepped (default: the paper's atmosphere).
+        method: ``averaged`` integrates the orbit-averaged equations (the reference),
+            ``curves`` interpolates the universal curves (fast), ``direct`` integrates
+            the non-averaged equations of motion (slow; a check). None (default): the
+            curves wherever the orbit lies on them (perigee up to 1100 km, apogee up to
+            4000 km) for the package's own atmospheres and for every dated one; the
+            averaged equations otherwise (above the curves, an exponential law, a user's
+            profile). The curves agree with the averaged equations to 0.06% and answer in
+            milliseconds once built and cached on disk.
         inclination_deg: Orbit inclination (matters with a rotating atmosphere,
             and sets the latitudes NRLMSIS is averaged over).
-        activity: Use NRLMSIS 2.1 under this solar activity
-            (`orbit_env.decay.solar`; needs pymsis). Constant activity without an
-            epoch is one fixed profile (every method); otherwise the satellite is
-            stepped through time on the universal curves (``method="curves"``,
-            `orbit_env.decay.chunked`) or, as a slow reference, by the averaged
-            equations with a fresh profile every day (``method="averaged"``).
+        rho100_kg_m3: The paper atmosphere's density at 100 km.
+        density_scale: Multiply the density profile.
+        atmosphere: Any density model of the user's (`ProfileAir`).
+        rotating_atmosphere: Let the air co-rotate with the Earth (section 5; None: the
+            model's default).
+        activity: Use NRLMSIS 2.1 under this solar activity (`orbit_env.decay.solar`).
+            Constant activity without an epoch is one fixed profile (every method);
+            otherwise the satellite is stepped through time on the universal curves
+            (``method="curves"``, `orbit_env.decay.chunked`) or, as a slow reference, by
+            the averaged equations with a fresh profile every day (``method="averaged"``).
         epoch: Date of the orbit (``YYYY-MM-DD``, or unix days). With NRLMSIS it
             makes the season count, and places the orbit in time-varying activity.
             None: a table's first date; for other activity day 0 (1970-01-01)
@@ -270,62 +280,37 @@ def lifetime(
         >>> round(result.nu, -1), round(result.revolutions, -2)
         (2910.0, 7600.0)
     """
-    if method not in METHODS:
+    if method is not None and method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     hp_m, ha_m = (float(x) for x in validate_heights_km(perigee_km, apogee_km))
     satellite = satellite or Satellite()
-    low, high, why = DENSITY_SCALE_RANGE
-    scale = check_number(density_scale, "density_scale", low=low, high=high, why=why)
-    if activity is not None or epoch is not None:
-        if atmosphere is not None or rho100_kg_m3 is not None:
-            raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
-        if activity is None:
-            from orbit_env.decay.solar_record import load_record
-
-            activity = load_record()  # a date and no activity: the observed and forecast Sun
-        if isinstance(activity, ConstantActivity) and epoch is None:
-            from orbit_env.physics.atmosphere.msis import MsisAtmosphere
-
-            atmosphere = MsisAtmosphere(
-                activity.f107_sfu,
-                activity.f107a_sfu,
-                activity.ap,
-                inclination_deg,
-                None,
-                ascending_node_local_time_h,
-                scale,
-            )
-            scale = 1.0
-        else:
-            return _lifetime_under_activity(
-                hp_m,
-                ha_m,
-                satellite,
-                method,
-                scale,
-                SolarDecayModel(
-                    activity,
-                    _start_days(activity, epoch),
-                    inclination_deg,
-                    follow_season=epoch is not None,
-                    rotating_atmosphere=rotating_atmosphere,
-                    ascending_node_local_time_h=ascending_node_local_time_h,
-                    chunk_days=chunk_days,
-                ),
-            )
-    if atmosphere is None:
-        atmosphere = PaperAtmosphere(scale=scale) if rho100_kg_m3 is None else PaperAtmosphere(rho100_kg_m3, scale)
-    elif rho100_kg_m3 is not None:
-        raise ValueError("rho100_kg_m3 applies to the paper's atmosphere only; scale your own model instead")
-    elif scale != 1.0:
-        raise ValueError("density_scale applies to the paper's atmosphere only; scale your own model instead")
+    keywords = {
+        "rho100_kg_m3": rho100_kg_m3,
+        "atmosphere": atmosphere,
+        "rotating_atmosphere": rotating_atmosphere,
+        "activity": activity,
+        "epoch": epoch,
+        "ascending_node_local_time_h": ascending_node_local_time_h,
+    }
+    if scenario is None:
+        scenario = scenario_from_keywords(density_scale=density_scale, chunk_days=chunk_days, **keywords)
+    elif any(value is not None for value in keywords.values()) or density_scale != 1.0:
+        given = ", ".join(name for name, value in keywords.items() if value is not None) or "density_scale"
+        raise ValueError(f"give the air either as a scenario or as keywords, not both (here: scenario and {given})")
+    method = method or default_method(scenario, hp_m, ha_m)
+    if scenario.time_varying:
+        return _lifetime_under_activity(
+            hp_m, ha_m, satellite, method, scenario.density_scale, scenario.solar_model(inclination_deg)
+        )
+    atmosphere = scenario.air.profile(inclination_deg, scenario.density_scale)
     rho_perigee = float(np.asarray(atmosphere.density_kg_m3(hp_m)))
     if not (math.isfinite(rho_perigee) and rho_perigee > 0.0):
         raise ValueError(
             f"the density at the perigee is {rho_perigee:g} kg/m^3 in this atmosphere (it underflows): no drag, "
             "no re-entry; check the law's values"
         )
-    model = DecayModel(atmosphere, rotating_atmosphere=rotating_atmosphere, inclination_deg=inclination_deg)
+    rotating = scenario.corotating
+    model = DecayModel(atmosphere, rotating_atmosphere=rotating, inclination_deg=inclination_deg)
     per_nu = satellite.revolutions_per_nu
     to_days = 1.0 / (float(nu_per_revolution(satellite.drag_parameter_m2_kg)) * SECONDS_PER_DAY)
     if method == "direct":
@@ -336,7 +321,7 @@ def lifetime(
             ha_m,
             satellite.drag_parameter_m2_kg,
             atmosphere=atmosphere,
-            rotating_atmosphere=rotating_atmosphere,
+            rotating_atmosphere=rotating,
             inclination_deg=inclination_deg,
         )
         if not direct.reentered:
@@ -383,6 +368,54 @@ def lifetime(
         )
         revolutions, days = nu * per_nu, weighted * to_days
     return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, check_lifetime_days(days), method, history)
+
+
+def default_method(scenario: Scenario, perigee_m: float, apogee_m: float) -> Method:
+    """The method `lifetime` takes when none is given (see its ``method``)."""
+    on_curves = perigee_m <= CURVES_MAX_PERIGEE_M and apogee_m <= CURVES_MAX_APOGEE_M
+    return "curves" if scenario.time_varying or (scenario.air.curves_by_default and on_curves) else "averaged"
+
+
+def scenario_from_keywords(
+    *,
+    rho100_kg_m3: float | None = None,
+    density_scale: float = 1.0,
+    atmosphere: Atmosphere | None = None,
+    rotating_atmosphere: bool | None = None,
+    activity: SolarActivity | None = None,
+    epoch: str | float | None = None,
+    ascending_node_local_time_h: float | None = None,
+    chunk_days: float = DEFAULT_CHUNK_DAYS,
+) -> Scenario:
+    """The `Scenario` of `lifetime`'s keywords: NRLMSIS with an activity or epoch, a user's profile, else the paper's.
+
+    Raises:
+        ValueError: keywords of two models at once, or a value out of its range.
+    """
+    low, high, why = DENSITY_SCALE_RANGE
+    scale = check_number(density_scale, "density_scale", low=low, high=high, why=why)
+    air: Air
+    if activity is not None or epoch is not None:
+        if atmosphere is not None or rho100_kg_m3 is not None:
+            raise ValueError("solar activity selects the NRLMSIS atmosphere; do not give an atmosphere or rho100 too")
+        if activity is None:
+            from orbit_env.decay.solar_record import load_record
+
+            activity = load_record()  # a date and no activity: the observed and forecast Sun
+        if isinstance(activity, ConstantActivity) and epoch is None:
+            air = MsisAir(activity, None, ascending_node_local_time_h)
+        else:
+            start = _start_days(activity, epoch)
+            air = MsisAir(activity, start, ascending_node_local_time_h, follow_season=epoch is not None)
+    elif atmosphere is not None:
+        if rho100_kg_m3 is not None:
+            raise ValueError("rho100_kg_m3 applies to the paper's atmosphere only; scale your own model instead")
+        if scale != 1.0:
+            raise ValueError("density_scale applies to the package's atmospheres only; scale your own model instead")
+        air = ProfileAir(as_atmosphere(atmosphere))
+    else:
+        air = PaperAir(rho100_kg_m3)
+    return Scenario(air, scale, rotating_atmosphere, chunk_days)
 
 
 def check_lifetime_days(days: float) -> float:

@@ -166,9 +166,9 @@ def lifetime_spread(
     sources["solar_forecast"] = SOLAR_FORECAST_SIGMA
     from orbit_env.decay.chunked import propagate
 
-    activity = scenario.solar
-    after = getattr(activity, "observed_end_days", -math.inf)
     base = scenario.solar_model(inclination_deg)
+    activity = base.activity
+    after = getattr(activity, "observed_end_days", -math.inf)
     # Each sample's lifetime is interpolated in z between the two nodes around it, in log days.
     nodes = np.array(SOLAR_NODES)
     right = np.clip(np.searchsorted(nodes, z_sun), 1, nodes.size - 1)

@@ -14,6 +14,7 @@ import sys
 import time
 from typing import Any
 
+from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.lifetime import (
     METHODS,
     PAPER_DRAG_COEFFICIENT,
@@ -22,93 +23,26 @@ from orbit_env.analysis.lifetime import (
     lifetime,
     make_satellite,
 )
-from orbit_env.analysis.scenario import ATMOSPHERES, Scenario
-from orbit_env.checks import check_date, check_number
+from orbit_env.analysis.scenario import Scenario
+from orbit_env.checks import check_number
 from orbit_env.cli import orbit_inputs
 from orbit_env.cli.common import PROG, check_finite, flag, given, number, write_csv
-from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
 from orbit_env.decay.solar import (
-    DEFAULT_AP,
-    ConstantActivity,
-    CycleActivity,
-    SolarActivity,
     TableActivity,
     iso_date,
-    read_solar_csv,
-    unix_days,
 )
-from orbit_env.physics.atmosphere import ExponentialAtmosphere
-
-_MSIS_ONLY = ("f107", "f107a", "ap", "solar_csv", "solar_cycle", "cycle_phase", "epoch", "node_local_time")
-_EXPONENTIAL_ONLY = ("rho0", "h0_km", "scale_height_km")
 
 
 def _scenario(args: argparse.Namespace) -> Scenario:
-    """The atmosphere and solar activity chosen on the command line."""
-    kind = args.atmosphere
-    for name in _MSIS_ONLY:
-        if kind != "msis" and given(args, name):
-            raise ValueError(f"{flag(name)} applies to --atmosphere msis")
-    for name in _EXPONENTIAL_ONLY:
-        if kind != "exponential" and given(args, name):
-            raise ValueError(f"{flag(name)} applies to --atmosphere exponential")
-    if kind != "paper" and args.rho100 is not None:
-        raise ValueError("--rho100 applies to --atmosphere paper")
-    common = {
-        "density_scale": args.density_scale,
-        "rotating_atmosphere": args.rotating_atmosphere,
-        "chunk_days": args.chunk_days,
-    }
-    if kind == "paper":
-        return Scenario("paper", rho100_kg_m3=args.rho100, **common)
-    if kind == "exponential":
-        typed = [args.rho0, args.h0_km, args.scale_height_km]
-        if any(value is None for value in typed) and any(value is not None for value in typed):
-            # A density from one law and a scale height from another make a third that nobody measured.
-            raise ValueError(
-                "give --rho0, --h0-km and --scale-height-km together (one law's three values), "
-                "or none for the orbital-height law"
-            )
-        if args.rho0 is None:
-            exponential = ExponentialAtmosphere()  # ORBITAL_LAW, named in the atmosphere line
-        else:
-            exponential = ExponentialAtmosphere(args.rho0, args.h0_km * 1e3, args.scale_height_km * 1e3)
-        return Scenario(
-            "exponential",
-            rho0_kg_m3=exponential.rho0_kg_m3,
-            h0_m=exponential.h0_m,
-            scale_height_m=exponential.scale_height_m,
-            **common,
-        )
-    epoch = None if args.epoch is None else check_date(unix_days(args.epoch), "--epoch", text=args.epoch)
-    activity: SolarActivity
-    if args.solar_csv and args.solar_cycle:
-        raise ValueError("give either --solar-csv or --solar-cycle, not both")
-    if (args.solar_csv or args.solar_cycle) and (args.f107 is not None or args.f107a is not None):
-        raise ValueError("--f107/--f107a set constant activity; they do not combine with --solar-csv/--solar-cycle")
-    if args.cycle_phase is not None and not args.solar_cycle:
-        raise ValueError("--cycle-phase applies to --solar-cycle")
-    if args.solar_csv:
-        activity = read_solar_csv(args.solar_csv, default_ap=DEFAULT_AP if args.ap is None else args.ap)
-        if epoch is None:
-            epoch = activity.start_days
-    elif args.solar_cycle:
-        if epoch is None:
-            raise ValueError("--solar-cycle needs --epoch (the orbit's date; it sets the phase and the season)")
-        activity = CycleActivity() if args.cycle_phase is None else CycleActivity.with_phase(args.cycle_phase, epoch)
-    elif epoch is not None and args.f107 is None and args.f107a is None and args.ap is None:
-        # A real date and no other solar option: the real Sun (the shipped or imported record).
-        from orbit_env.decay.solar_record import load_record
-
-        activity = load_record()
-    else:
-        f107 = 150.0 if args.f107 is None else args.f107
-        activity = ConstantActivity(
-            f107, f107 if args.f107a is None else args.f107a, 15.0 if args.ap is None else args.ap
-        )
-    return Scenario(
-        "msis", activity=activity, epoch_days=epoch, ascending_node_local_time_h=args.node_local_time, **common
-    )
+    """The air and its stepping as chosen on the command line (each model reads its own options)."""
+    chosen = air_model(args.atmosphere)
+    for model in AIR_MODELS.values():
+        for name in model.options:
+            if model is not chosen and name not in chosen.options and given(args, name):
+                raise ValueError(f"{flag(name)} applies to --atmosphere {model.name}")
+    air = chosen.from_options({name: getattr(args, name) for name in chosen.options})
+    rotating = True if args.rotating_atmosphere else None  # None: the model's own default
+    return Scenario(air, args.density_scale, rotating, args.chunk_days)
 
 
 def _satellite(args: argparse.Namespace) -> Satellite:
@@ -119,8 +53,7 @@ def _satellite(args: argparse.Namespace) -> Satellite:
 def _atmosphere(args: argparse.Namespace, scenario: Scenario) -> str:
     """The atmosphere line; says so when the inclination it depends on is the default, not the user's."""
     text = scenario.describe(args.inclination)
-    depends = scenario.atmosphere == "msis" or scenario.rotating_atmosphere
-    if depends and getattr(args, "inclination_defaulted", False):
+    if scenario.depends_on_inclination and getattr(args, "inclination_defaulted", False):
         text += " (the default: no --inclination given)"
     return text
 
@@ -186,34 +119,10 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         raise ValueError("give --perigee and --apogee, --semi-major-axis-km and --eccentricity, --tle, or --batch")
     perigee_km, apogee_km = orbit.sphere_heights_km
     offset = orbit.offset_km
-    # Default method: for the paper's atmosphere and NRLMSIS, the universal curves wherever the orbit lies
-    # on them (they agree with the averaged ODE to 0.06% and answer in milliseconds once built and cached
-    # on disk; with changing activity the averaged reference would rebuild NRLMSIS every day: minutes).
-    # The averaged ODE above the curves, and for an exponential law (any law a user gives, the sea-level
-    # ones too, whose curves may not be tabulable).
-    on_curves = perigee_km <= CURVES_MAX_PERIGEE_M / 1e3 and apogee_km <= CURVES_MAX_APOGEE_M / 1e3
-    curves_first = scenario.atmosphere != "exponential" and on_curves
-    method = args.method or ("curves" if scenario.time_varying or curves_first else "averaged")
-    options: dict[str, Any] = {
-        "satellite": satellite,
-        "method": method,
-        "rotating_atmosphere": args.rotating_atmosphere,
-        "inclination_deg": args.inclination,
-    }
-    if scenario.atmosphere == "paper":
-        options.update(rho100_kg_m3=args.rho100, density_scale=args.density_scale)
-    elif scenario.atmosphere == "exponential":
-        law = orbit_inputs.sphere_scenario(scenario, orbit.reference, args.inclination)
-        options["atmosphere"] = ExponentialAtmosphere(law.rho0_kg_m3, law.h0_m, law.scale_height_m, args.density_scale)
-    else:
-        options.update(
-            activity=scenario.solar,
-            epoch=scenario.epoch_days,
-            density_scale=args.density_scale,
-            ascending_node_local_time_h=args.node_local_time,
-            chunk_days=args.chunk_days,
-        )
-    result = lifetime(perigee_km, apogee_km, **options)
+    air = scenario.in_sphere_heights(orbit.reference, args.inclination)
+    result = lifetime(
+        perigee_km, apogee_km, satellite=satellite, scenario=air, method=args.method, inclination_deg=args.inclination
+    )
     if scenario.epoch_days is not None:
         _warn_solar_table(scenario, scenario.epoch_days + result.days)
     summary = result.to_dict()
@@ -235,7 +144,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             apogee_km,
             args.rule,
             satellite=satellite,
-            scenario=orbit_inputs.sphere_scenario(scenario, orbit.reference, args.inclination),
+            scenario=air,
             inclination_deg=args.inclination,
         )
         summary.update(
@@ -308,7 +217,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
         c,
         inc,
         status,
-        orbit_inputs.sphere_scenario(scenario, args.height_reference, args.inclination),
+        scenario.in_sphere_heights(args.height_reference, args.inclination),
         rule_years=args.rule,
         progress=not args.no_progress,
     )
@@ -342,7 +251,7 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:
-        args.atmosphere = "msis" if args.epoch is not None else "paper"
+        args.atmosphere = DATED_AIR if args.epoch is not None else DEFAULT_AIR
     satellite = _satellite(args)
     scenario = _scenario(args)
     observations = read_observations(args.observations)
@@ -385,7 +294,9 @@ def _add_satellite_options(parser: argparse.ArgumentParser, shapes: bool = False
 def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group = parser.add_argument_group("atmosphere")
     group.add_argument(
-        "--atmosphere", choices=ATMOSPHERES, help="density model (default: msis with an epoch or a TLE, else paper)"
+        "--atmosphere",
+        choices=tuple(AIR_MODELS),
+        help=f"density model (default: {DATED_AIR} with an epoch or a TLE, else {DEFAULT_AIR})",
     )
     group.add_argument("--rho100", type=number, metavar="KG_M3", help="paper: density at 100 km (default: calibrated)")
     group.add_argument("--density-scale", type=number, default=1.0, help="multiply the density (default 1)")

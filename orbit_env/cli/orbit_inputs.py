@@ -14,15 +14,11 @@ and back for what is printed. Heavy imports (sgp4, pymsis) happen inside the fun
 from __future__ import annotations
 
 import argparse
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
-from orbit_env.analysis.heights import (
-    HEIGHT_REFERENCES,
-    default_height_reference,
-    exponential_at_geodetic_altitude,
-    offset_km,
-)
+from orbit_env.analysis.air import DATED_AIR, DEFAULT_AIR, air_model
+from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
 from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
 from orbit_env.cli.common import given, number
 
@@ -109,7 +105,7 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         if len(sets) > 1:
             raise ValueError(f"{tle} holds {len(sets)} element sets; use --batch for more than one")
         elements = sets[0]
-        if args.epoch is None and args.atmosphere in (None, "msis"):
+        if args.epoch is None and "epoch" in air_model(args.atmosphere or DATED_AIR).options:
             args.epoch = elements.epoch_iso.rstrip("Z")
         if args.inclination is None:
             args.inclination = elements.inclination_deg
@@ -124,11 +120,11 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:
-        args.atmosphere = "msis" if args.epoch is not None else "paper"
+        args.atmosphere = DATED_AIR if args.epoch is not None else DEFAULT_AIR
     reference = getattr(args, "height_reference", None)
     args.height_reference_given = reference is not None
     if reference is None:
-        reference = "equatorial" if elements is not None else default_height_reference(args.atmosphere)
+        reference = "equatorial" if elements is not None else air_model(args.atmosphere).height_reference
     args.height_reference = reference
     if elements is not None:
         if reference != "equatorial":
@@ -183,16 +179,12 @@ def satellite_from_args(
 def _shape_drag_coefficient(body: Any, orbit: OrbitInput, scenario: Any, args: argparse.Namespace) -> Any:
     """The shape's C_D at the start orbit's mean height, in the scenario's gas (NRLMSIS)."""
     from orbit_env.analysis.shapes import drag_at_start
-    from orbit_env.decay.solar import ConstantActivity
 
     hp, ha = orbit.sphere_heights_km
-    if scenario.atmosphere == "msis":
-        start = scenario.epoch_days
-        indices = scenario.solar.indices(start) if start is not None else _constant(scenario.solar)
-        date = None if start is None else str(_datetime(start))
-    else:
-        # Other atmospheres have no temperature: the gas is NRLMSIS's at moderate activity.
-        indices, date = _constant(ConstantActivity(150.0, 150.0, 15.0)), None
+    # An air without a temperature of its own gives NRLMSIS's gas at moderate activity (Air.gas_activity).
+    activity, start = scenario.air.gas_activity()
+    indices = activity.indices(start) if start is not None else _constant(activity)
+    date = None if start is None else str(_datetime(start))
     result = drag_at_start(
         body,
         0.5 * (hp + ha) * 1e3,
@@ -217,18 +209,6 @@ def _datetime(days: float) -> Any:
     import numpy as np
 
     return np.datetime64(round(days * 86400.0), "s")
-
-
-def sphere_scenario(scenario: Any, reference: str, inclination_deg: float) -> Any:
-    """The scenario in the sphere's heights: the exponential law at the geodetic altitude (equatorial reference)."""
-    if scenario.atmosphere != "exponential" or reference != "equatorial":
-        return scenario
-    from orbit_env.physics.atmosphere import ExponentialAtmosphere
-
-    law = exponential_at_geodetic_altitude(
-        ExponentialAtmosphere(scenario.rho0_kg_m3, scenario.h0_m, scenario.scale_height_m), inclination_deg
-    )
-    return replace(scenario, rho0_kg_m3=law.rho0_kg_m3, h0_m=law.h0_m)
 
 
 def elements_report(elements: Any, result: Any = None) -> dict[str, Any]:
@@ -381,7 +361,7 @@ def uncertainty(
         perigee_km * 1e3,
         apogee_km * 1e3,
         satellite.drag_parameter_m2_kg,
-        sphere_scenario(scenario, orbit.reference, args.inclination),
+        scenario.in_sphere_heights(orbit.reference, args.inclination),
         args.inclination,
         samples=args.samples,
         seed=args.seed,
