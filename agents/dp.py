@@ -126,7 +126,7 @@ def _interpolation(axes: _Axes, label: FloatArray, life: FloatArray, dv_m_s: Flo
     return np.stack(index, axis=-1), np.stack(weight, axis=-1)
 
 
-class _Step(NamedTuple):
+class DPStep(NamedTuple):
     """One step of the task from arrays of states."""
 
     state: BatchState  # after the burn and the coast
@@ -134,7 +134,7 @@ class _Step(NamedTuple):
     reward: FloatArray
 
 
-class _Model:
+class DPModel:
     """The task with the density known, on arrays of grid states (the task model's functions)."""
 
     def __init__(self, config: OrbitRaisingConfig, density_scale: float) -> None:
@@ -158,19 +158,19 @@ class _Model:
         tau = np.log1p(life * self.step_nu(self.mass_kg(dv_left_m_s)) / NU_REF)
         return task_model.states_on_curves(self.task, label, tau, dv_left_m_s, 0.0)
 
-    def step(self, states: BatchState, requested_dv: float) -> _Step:
+    def step(self, states: BatchState, requested_dv: float) -> DPStep:
         """The task's step from ``states`` (not changed): burn (maybe), then coast."""
         after = states.copy()
         result = task_model.step(self.task, after, requested_dv)
         life = np.where(after.tau > 0.0, after.nu / (self.config.revolutions_per_step * after.nu_per_rev), 0.0)
-        return _Step(after, life, result.reward)
+        return DPStep(after, life, result.reward)
 
     def coast_days(self, states: BatchState, steps: Any) -> FloatArray:
         """The days of ``steps`` coasts in one (the sum of the task's coasts' days)."""
         return task_model.lookahead(self.task, states, 0.0, steps)[0]
 
 
-def _coast_certain_stages(model: _Model) -> int:
+def _coast_certain_stages(model: DPModel) -> int:
     """The stages k (steps left) up to which a satellite that outlives them coasts in the optimum.
 
     With n >= k the satellite lives through the mission coasting; a burn of dv
@@ -196,7 +196,7 @@ def _gcd(values: tuple[float, ...]) -> float:
     return reduce(math.gcd, micro, 0) / 1e6
 
 
-def _top_label(model: _Model) -> float:
+def _top_label(model: DPModel) -> float:
     """Label of the most elongated orbit reachable, plus ``LABEL_MARGIN``.
 
     The most elongated start (lowest perigee, highest apogee), decayed to any point
@@ -213,7 +213,7 @@ def _top_label(model: _Model) -> float:
     return max(float(curves.locate(perigee_m, raised_m).label.max()) + LABEL_MARGIN, MU_LOW + 1.0)
 
 
-def _labels(model: _Model, n_label: int) -> FloatArray:
+def _labels(model: DPModel, n_label: int) -> FloatArray:
     """The label axis: spacing in proportion to the label change of the smallest burn (see the module)."""
     config = model.config
     top = _top_label(model)
@@ -245,7 +245,7 @@ def _labels(model: _Model, n_label: int) -> FloatArray:
     return np.concatenate([fine_labels, above])
 
 
-def _axes(model: _Model, grid: tuple[int, int, int]) -> _Axes:
+def _axes(model: DPModel, grid: tuple[int, int, int]) -> _Axes:
     config = model.config
     n_label, life_per_step, dv_per_quantum = grid
     curves = model.curves
@@ -267,7 +267,7 @@ def _axes(model: _Model, grid: tuple[int, int, int]) -> _Axes:
     return _Axes(label, np.concatenate([unit, tail]), dv_m_s, unit.size, life_per_step)
 
 
-def _grid_states(model: _Model, axes: _Axes, rows: NDArray[np.intp]) -> BatchState:
+def _grid_states(model: DPModel, axes: _Axes, rows: NDArray[np.intp]) -> BatchState:
     """The task's states at flat grid indices."""
     j, rest = np.divmod(rows, axes.plane)
     i, k = np.divmod(rest, axes.dv_m_s.size)
@@ -283,19 +283,58 @@ class DPSolution:
         density_scale: The known density scale.
         grid: (labels, life levels per step, delta-v levels per burn quantum).
         solve_s: Wall time of the solve [s].
+        model: The task the values are of, on arrays of grid states.
+        coast_certain_stages: The stages (steps left) up to which a satellite that outlives them
+            coasts in the optimum (see the module).
     """
 
     config: OrbitRaisingConfig
     density_scale: float
     grid: tuple[int, int, int]
     solve_s: float
-    _model: _Model
+    model: DPModel
     _axes: _Axes
     _stages: StageValues  # the decision states of every stage, in units of VALUE_QUANTUM_DAYS
     _rows: NDArray[np.int64]  # decision states of stage k (a prefix of the state vector)
     _cumulative: FloatArray  # sums of the coasts' days along the life levels [days]
-    _coast_certain: int  # stages up to which the satellites that outlive them coast
+    coast_certain_stages: int
     _tail: BatchState  # the states of the life axis' tail
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """The solution as named arrays, for the disk cache (`from_arrays` reads them back)."""
+        axes = self._axes
+        return {
+            **self._stages.to_arrays(),
+            "label": axes.label,
+            "life": axes.life,
+            "dv_m_s": axes.dv_m_s,
+            "levels": np.array([axes.unit_levels, axes.life_per_step, self.coast_certain_stages]),
+            "rows": self._rows,
+            "cumulative": self._cumulative,
+            "solve_s": np.array(self.solve_s),
+        }
+
+    @classmethod
+    def from_arrays(
+        cls, config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, arrays: dict[str, np.ndarray]
+    ) -> DPSolution:
+        """The solution of ``config``, ``grid`` and ``density_scale`` from the arrays of `to_arrays`."""
+        model = DPModel(config, density_scale)
+        unit_levels, life_per_step, certain = (int(x) for x in arrays["levels"])
+        axes = _Axes(arrays["label"], arrays["life"], arrays["dv_m_s"], unit_levels, life_per_step)
+        return cls(
+            config,
+            density_scale,
+            grid,
+            float(arrays["solve_s"]),
+            model,
+            axes,
+            StageValues.from_arrays(arrays),
+            arrays["rows"],
+            arrays["cumulative"],
+            certain,
+            _tail_states(model, axes),
+        )
 
     @property
     def num_states(self) -> int:
@@ -307,8 +346,13 @@ class DPSolution:
         """Values stored over all stages (the decision states)."""
         return int(self._rows[1:].sum())
 
-    def _coast_days(self, stage: int, rows: NDArray[np.intp]) -> FloatArray:
-        """The days of ``stage`` coasts from grid states that outlive them [days]."""
+    @property
+    def task(self) -> Task:
+        """The task solved: the config's, with the density known at ``density_scale``."""
+        return self.model.task
+
+    def coast_days(self, stage: int, rows: NDArray[np.intp]) -> FloatArray:
+        """The days of ``stage`` coasts from the grid states ``rows`` (flat indices) that outlive them [days]."""
         axes = self._axes
         unit_rows = axes.unit_levels * axes.plane
         out = np.empty(rows.shape)
@@ -318,7 +362,7 @@ class DPSolution:
         tail = np.flatnonzero(~unit)
         for start in range(0, tail.size, CHUNK_STATES):
             chunk = tail[start : start + CHUNK_STATES]
-            out[chunk] = self._model.coast_days(self._tail.take(rows[chunk] - unit_rows), stage)
+            out[chunk] = self.model.coast_days(self._tail.take(rows[chunk] - unit_rows), stage)
         return out
 
     def stage_values(self, stage: int, rows: Any = None) -> FloatArray:
@@ -330,7 +374,7 @@ class DPSolution:
         stored = rows < self._rows[stage]
         out[stored] = self._stages.get(stage)[rows[stored]] * VALUE_QUANTUM_DAYS
         if not stored.all():
-            out[~stored] = self._coast_days(stage, rows[~stored])
+            out[~stored] = self.coast_days(stage, rows[~stored])
         return out
 
     def q_values(self, states: BatchState, steps_left: NDArray[np.intp]) -> FloatArray:
@@ -338,12 +382,12 @@ class DPSolution:
         stage = np.clip(steps_left - 1, 0, self.config.horizon_steps - 1)
         q = np.empty((states.size, len(self.config.burn_sizes_m_s)))
         for a, burn in enumerate(self.config.burn_sizes_m_s):
-            step = self._model.step(states, burn)
+            step = self.model.step(states, burn)
             future = np.zeros(q.shape[0])
             # A successor that outlives the mission coasts: its days are summed exactly.
-            exact = (stage <= self._coast_certain) & (step.life >= stage)
+            exact = (stage <= self.coast_certain_stages) & (step.life >= stage)
             if exact.any():
-                future[exact] = self._model.coast_days(step.state.take(exact), stage[exact])
+                future[exact] = self.model.coast_days(step.state.take(exact), stage[exact])
             index, weight = _interpolation(self._axes, step.state.label, step.life, step.state.dv_left_m_s)
             for s in np.unique(stage[~exact]):
                 mine = ~exact & (stage == s)
@@ -352,6 +396,19 @@ class DPSolution:
         # A re-entered satellite or an ended mission earns nothing more.
         q[(steps_left <= 0) | (states.tau <= 0.0)] = 0.0
         return q
+
+    def no_choice(self, states: BatchState, steps_left: NDArray[np.intp]) -> NDArray[np.bool_]:
+        """States with nothing to decide: an empty tank, or a satellite that outlives the mission coasting.
+
+        Coasting is proven optimal there up to the stage ``coast_certain_stages`` (see the module).
+        """
+        outlives = (steps_left <= self.coast_certain_stages) & task_model.outlives(self.task, states, steps_left)
+        return (states.dv_left_m_s <= 0.0) | outlives
+
+    def burns_m_s(self, states: BatchState, steps_left: NDArray[np.intp]) -> FloatArray:
+        """The one-step DP policy's burns [m/s]: argmax_a r_a + V_{k-1}(successor_a) (`q_values`)."""
+        sizes = np.asarray(self.config.burn_sizes_m_s, dtype=np.float64)
+        return sizes[np.argmax(self.q_values(states, steps_left), axis=1)]
 
     def value(self, perigee_km: Any, apogee_km: Any, dv_left_m_s: Any, steps_left: Any) -> FloatArray:
         """The optimum's expected return from a state [days] (arrays broadcast).
@@ -377,7 +434,7 @@ class DPSolution:
             raise ValueError(f"steps_left={steps_left!r} is invalid; allowed: integers 0 to {horizon}")
         shape = hp.shape
         k = k.ravel().astype(np.intp)
-        states = task_model.states_at_orbits(self._model.task, hp.ravel(), ha.ravel(), dv.ravel(), horizon - k)
+        states = task_model.states_at_orbits(self.model.task, hp.ravel(), ha.ravel(), dv.ravel(), horizon - k)
         return self.q_values(states, k).max(axis=1).reshape(shape)
 
 
@@ -425,7 +482,7 @@ def solve(
     return _solve(config, grid, float(density_scale), bool(progress))
 
 
-def _transitions(model: _Model, axes: _Axes, decision_rows: int) -> tuple[NDArray[np.float32], list[Any], Any]:
+def _transitions(model: DPModel, axes: _Axes, decision_rows: int) -> tuple[NDArray[np.float32], list[Any], Any]:
     """Rewards (actions, states), the actions' interpolation matrices and the tail's coast matrix.
 
     The actions are the coast first (if the config has one), then the burns in
@@ -498,44 +555,9 @@ def _cache_description(config: OrbitRaisingConfig, grid: tuple[int, int, int], d
     return cache.describe((config, grid, density_scale))
 
 
-def _tail_states(model: _Model, axes: _Axes) -> BatchState:
+def _tail_states(model: DPModel, axes: _Axes) -> BatchState:
     """The states of the life axis' tail (above the horizon + 1)."""
     return _grid_states(model, axes, np.arange(axes.unit_levels * axes.plane, axes.size))
-
-
-def _to_cache(solution: DPSolution) -> dict[str, np.ndarray]:
-    axes = solution._axes
-    return {
-        **solution._stages.to_arrays(),
-        "label": axes.label,
-        "life": axes.life,
-        "dv_m_s": axes.dv_m_s,
-        "levels": np.array([axes.unit_levels, axes.life_per_step, solution._coast_certain]),
-        "rows": solution._rows,
-        "cumulative": solution._cumulative,
-        "solve_s": np.array(solution.solve_s),
-    }
-
-
-def _from_cache(
-    config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, arrays: dict[str, np.ndarray]
-) -> DPSolution:
-    model = _Model(config, density_scale)
-    unit_levels, life_per_step, certain = (int(x) for x in arrays["levels"])
-    axes = _Axes(arrays["label"], arrays["life"], arrays["dv_m_s"], unit_levels, life_per_step)
-    return DPSolution(
-        config,
-        density_scale,
-        grid,
-        float(arrays["solve_s"]),
-        model,
-        axes,
-        StageValues.from_arrays(arrays),
-        arrays["rows"],
-        arrays["cumulative"],
-        certain,
-        _tail_states(model, axes),
-    )
 
 
 @lru_cache(maxsize=4)
@@ -545,10 +567,10 @@ def _solve(config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale
     if arrays is not None:
         if progress:
             print("dp: solution read from the disk cache", file=sys.stderr)
-        return _from_cache(config, grid, density_scale, arrays)
+        return DPSolution.from_arrays(config, grid, density_scale, arrays)
     solution = _backward_induction(config, grid, density_scale, progress)
     # Stored uncompressed: the stages are compressed already.
-    cache.store(CACHE_KIND, description, _to_cache(solution), compress=False)
+    cache.store(CACHE_KIND, description, solution.to_arrays(), compress=False)
     return solution
 
 
@@ -556,7 +578,7 @@ def _backward_induction(
     config: OrbitRaisingConfig, grid: tuple[int, int, int], density_scale: float, progress: bool
 ) -> DPSolution:
     start = time.perf_counter()
-    model = _Model(config, density_scale)
+    model = DPModel(config, density_scale)
     axes = _axes(model, grid)
     n, plane, unit_rows = axes.size, axes.plane, axes.unit_levels * axes.plane
     horizon = config.horizon_steps
@@ -616,7 +638,7 @@ def _backward_induction(
             np.maximum(best, q, out=best)
         if r < n:
             np.subtract(cumulative[r:unit_rows], cumulative[r - k * down : unit_rows - k * down], out=new[r:unit_rows])
-            new[tail_rows] = solution._coast_days(k, tail_rows)
+            new[tail_rows] = solution.coast_days(k, tail_rows)
         stored = scratch[:r]
         np.maximum(best, 0.0, out=stored)
         stored *= 1.0 / VALUE_QUANTUM_DAYS
@@ -646,22 +668,6 @@ ROLLOUT_MAX_BURNS = 16
 ROLLOUT_TIE_DAYS = 0.005
 
 
-def _no_choice(solution: DPSolution, states: BatchState, steps_left: NDArray[np.intp]) -> NDArray[np.bool_]:
-    """States with nothing to decide: an empty tank, or a satellite that outlives the mission coasting.
-
-    Coasting is proven optimal there up to the stage ``_coast_certain`` (see the module).
-    """
-    task = solution._model.task
-    outlives = (steps_left <= solution._coast_certain) & task_model.outlives(task, states, steps_left)
-    return (states.dv_left_m_s <= 0.0) | outlives
-
-
-def _base_burns(solution: DPSolution, states: BatchState, steps_left: NDArray[np.intp]) -> FloatArray:
-    """The base DP policy's burns [m/s]: argmax_a r_a + V_{k-1}(successor_a)."""
-    sizes = np.asarray(solution.config.burn_sizes_m_s, dtype=np.float64)
-    return sizes[np.argmax(solution.q_values(states, steps_left), axis=1)]
-
-
 def rollout_returns(
     solution: DPSolution,
     states: BatchState,
@@ -672,7 +678,7 @@ def rollout_returns(
     """Exact returns of burning ``prefix_m_s`` (rows, m) on the next m steps, then the best continuation.
 
     The continuations, played in the task model (no interpolation): the base DP policy
-    to the end (a choice only while there is one, `_no_choice`; then the coasts' days
+    to the end (a choice only while there is one, `DPSolution.no_choice`; then the coasts' days
     summed exactly), and the base policy's first j burns on consecutive steps, then
     coasting, for j = 0, 1, ... (the base's deferred burns brought forward), among
     those whose burns end before step ``last_step`` (after it the rollout policy acts
@@ -688,7 +694,7 @@ def rollout_returns(
     Returns:
         The returns [days], shape (n,).
     """
-    task = solution._model.task
+    task = solution.task
     s = states.copy()
     k = np.asarray(steps_left, dtype=np.intp).copy()
     total = np.zeros(s.size)
@@ -701,7 +707,7 @@ def rollout_returns(
     burns = np.zeros((s.size, ROLLOUT_MAX_BURNS))
     count = np.zeros(s.size, np.intp)
     alive = (s.tau > 0.0) & (k > 0)
-    done = alive & _no_choice(solution, s, k)
+    done = alive & solution.no_choice(s, k)
     if done.any():
         total[done] += task_model.lookahead(task, s.take(done), 0.0, k[done])[0]
     active = np.flatnonzero(alive & ~done)
@@ -709,7 +715,7 @@ def rollout_returns(
         # The base policy on the satellites that still have a choice, all at the same stages
         # when the states came from one step of a vector env (one stage read per step).
         batch = s.take(active)
-        result = task_model.step(task, batch, _base_burns(solution, batch, k[active]))
+        result = task_model.step(task, batch, solution.burns_m_s(batch, k[active]))
         total[active] += result.reward
         burned = (np.asarray(result.burn_m_s) > 0.0) & (count[active] < ROLLOUT_MAX_BURNS)
         recorded = active[burned]
@@ -718,7 +724,7 @@ def rollout_returns(
         k[active] -= 1
         s.put(active, batch)
         alive = (batch.tau > 0.0) & (k[active] > 0)
-        done = alive & _no_choice(solution, batch, k[active])
+        done = alive & solution.no_choice(batch, k[active])
         if done.any():
             finished = active[done]
             total[finished] += task_model.lookahead(task, batch.take(done), 0.0, k[finished])[0]
@@ -807,20 +813,20 @@ class DPPolicy:
     def burns_m_s(self, observation: Any) -> FloatArray:
         """The burns chosen for a batch of observations (n, 7) or one (7,), as an array (n,) [m/s]."""
         sizes = np.asarray(self.config.burn_sizes_m_s, dtype=np.float64)
-        states = task_model.decode(self.solution._model.task, observation)
+        states = task_model.decode(self.solution.task, observation)
         steps_left = (self.config.horizon_steps - states.steps).astype(np.intp)
         if self.lookahead == 1:
             q = self.solution.q_values(states, steps_left)
         else:
             q = np.empty((states.size, sizes.size))
             for a, burn in enumerate(self.config.burn_sizes_m_s):
-                step = self.solution._model.step(states, burn)
+                step = self.solution.model.step(states, burn)
                 q[:, a] = step.reward + self.solution.q_values(step.state, steps_left - 1).max(axis=1)
             q[(steps_left <= 0) | (states.tau <= 0.0)] = 0.0
         burns = sizes[np.argmax(q, axis=1)]
         if self.rollout:
             deciding = (steps_left > 0) & (states.tau > 0.0) & (states.steps < self.rollout_steps)
-            rows = np.flatnonzero(deciding & ~_no_choice(self.solution, states, steps_left))
+            rows = np.flatnonzero(deciding & ~self.solution.no_choice(states, steps_left))
             if rows.size:
                 burns[rows] = self._improve(states.take(rows), steps_left[rows], burns[rows])
         return burns

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.agents.dp import DPPolicy, _base_burns, _no_choice
+from orbit_env.agents.dp import DPPolicy
 from orbit_env.envs import task as task_model
 from orbit_env.envs.task import BatchState
 
@@ -116,7 +116,7 @@ class PlanPolicy:
         self.base = base
         self.solution = base.solution
         self.config = base.config
-        self.task = self.solution._model.task
+        self.task = self.solution.task
         # The task the plans act in: the same satellite, with the Box action (`Task.encode`).
         self._acting = task_model.Task(self.config, self.task.density, continuous=True)
         self.window = int(window)
@@ -131,7 +131,7 @@ class PlanPolicy:
         steps = states.steps.astype(np.intp)
         burns = np.zeros(states.size)
         deciding = (steps < horizon) & (states.tau > 0.0)
-        rows = np.flatnonzero(deciding & ~_no_choice(self.solution, states, horizon - steps))
+        rows = np.flatnonzero(deciding & ~self.solution.no_choice(states, horizon - steps))
         if not rows.size:
             return burns
         found, planned = self._lookup(_features(states.take(rows)), steps[rows])
@@ -218,12 +218,12 @@ class PlanPolicy:
         for t in range(horizon):
             here = s.take(active)
             k = horizon - here.steps.astype(np.intp)
-            choosing = (here.tau > 0.0) & (k > 0) & ~_no_choice(self.solution, here, k)
+            choosing = (here.tau > 0.0) & (k > 0) & ~self.solution.no_choice(here, k)
             active, k = active[choosing], k[choosing]
             if not active.size:
                 break
             batch = here.take(choosing)
-            recorded[active, t] = task_model.step(self.task, batch, _base_burns(self.solution, batch, k)).burn_m_s
+            recorded[active, t] = task_model.step(self.task, batch, self.solution.burns_m_s(batch, k)).burn_m_s
             s.put(active, batch)
         burned = np.flatnonzero(recorded.any(axis=0))
         room = int(horizon - states.steps.min())
@@ -267,7 +267,7 @@ class PlanPolicy:
         gained = 0.0
         for t in range(length - 1, -1, -1):
             at = before[t]
-            rows = np.flatnonzero((at.tau > 0.0) & ~_no_choice(self.solution, at, horizon - at.steps.astype(np.intp)))
+            rows = np.flatnonzero((at.tau > 0.0) & ~self.solution.no_choice(at, horizon - at.steps.astype(np.intp)))
             if not rows.size:
                 continue
             now = burns[rows, t:]

@@ -31,8 +31,8 @@ def test_curves_are_stored_once_and_read_back_identical(folder):
     files = list(folder.glob("curves-*.npz"))
     assert len(files) == 1 and not list(folder.glob("*.tmp"))
     loaded = UniversalCurves(model)
-    np.testing.assert_array_equal(loaded._table_a.cells, built._table_a.cells)
-    np.testing.assert_array_equal(loaded._table_b.cells, built._table_b.cells)
+    np.testing.assert_array_equal(loaded.table_a.cells, built.table_a.cells)
+    np.testing.assert_array_equal(loaded.table_b.cells, built.table_b.cells)
     # Another model is another file.
     UniversalCurves(DecayModel(ExponentialAtmosphere(2e-11, 400e3, 60e3)))
     assert len(list(folder.glob("curves-*.npz"))) == 2
@@ -45,7 +45,7 @@ def test_a_damaged_file_is_built_again(folder):
     path.write_bytes(b"not a zip file")
     assert cache.load("curves", cache.describe(model)) is None  # unreadable: as if not cached
     again = UniversalCurves(model)
-    np.testing.assert_array_equal(again._table_b.cells, built._table_b.cells)
+    np.testing.assert_array_equal(again.table_b.cells, built.table_b.cells)
     with np.load(path) as data:  # rewritten whole
         assert set(data.files) == {"a", "b"}
 

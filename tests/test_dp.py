@@ -138,8 +138,8 @@ def test_a_satellite_that_outlives_the_mission_is_worth_its_coasting_days():
     never, starts = run_vector(LONG, lambda obs: np.zeros(len(obs), dtype=np.int64))
     solution = solve(LONG, grid=(8, 1, 1))
     full, steps = LONG.delta_v_capacity_m_s, LONG.horizon_steps
-    states = task_model.states_at_orbits(solution._model.task, starts[:, 0] * 1e3, starts[:, 1] * 1e3, full, 0.0)
-    outlive = task_model.outlives(solution._model.task, states, steps)
+    states = task_model.states_at_orbits(solution.task, starts[:, 0] * 1e3, starts[:, 1] * 1e3, full, 0.0)
+    outlive = task_model.outlives(solution.task, states, steps)
     assert outlive.sum() >= 5
     value = solution.value(starts[:, 0], starts[:, 1], full, steps)
     # Equal up to locating the env's heights again (its heights are read back from its
@@ -156,7 +156,7 @@ def test_coasting_where_the_satellite_outlives_the_mission_changes_no_value(monk
     # coasts are then interpolated, and the values stored in steps of 0.01 day).
     config = OrbitRaisingConfig(**{**CONFIG.__dict__, "propellant_cost_per_m_s": cost})
     restricted = dp._backward_induction(config, GRID, 1.0, False)
-    assert restricted._coast_certain == (60 if cost == 0.05 else 48)
+    assert restricted.coast_certain_stages == (60 if cost == 0.05 else 48)
     monkeypatch.setattr(dp, "_coast_certain_stages", lambda model: 0)
     everywhere = dp._backward_induction(config, GRID, 1.0, False)
     assert everywhere.stored_values == (config.horizon_steps + 1 - 1) * everywhere.num_states
@@ -167,12 +167,12 @@ def test_coasting_where_the_satellite_outlives_the_mission_changes_no_value(monk
 
 
 def test_coast_certain_stages_follow_the_propellant_cost():
-    model = dp._Model(OrbitRaisingConfig(), 1.0)
+    model = dp.DPModel(OrbitRaisingConfig(), 1.0)
     # At most 0.30 day per m/s of longer periods over 365 steps, below the cost of 0.4.
     assert dp._coast_certain_stages(model) == 365
-    cheap = dp._Model(OrbitRaisingConfig(propellant_cost_per_m_s=0.1), 1.0)
+    cheap = dp.DPModel(OrbitRaisingConfig(propellant_cost_per_m_s=0.1), 1.0)
     assert 100 < dp._coast_certain_stages(cheap) < 150
-    free = dp._Model(OrbitRaisingConfig(propellant_cost_per_m_s=0.0), 1.0)
+    free = dp.DPModel(OrbitRaisingConfig(propellant_cost_per_m_s=0.0), 1.0)
     assert dp._coast_certain_stages(free) == 0
 
 
@@ -284,7 +284,7 @@ def test_the_rollouts_returns_are_the_envs_for_the_plans_they_play(solution):
     # no choice) and coasting (last_step=0: no burn brought forward), all in the task model.
     def base_then_coast(states):
         k = (CONFIG.horizon_steps - states.steps).astype(np.intp)
-        return 0.0 if dp._no_choice(solution, states, k)[0] else float(dp._base_burns(solution, states, k)[0])
+        return 0.0 if solution.no_choice(states, k)[0] else float(solution.burns_m_s(states, k)[0])
 
     prefixes = [(30.0, 0.0), (0.0, 10.0), (100.0, 100.0), (0.0, 0.0)]
     for seed in range(8):

@@ -997,10 +997,10 @@ def test_cell_interpolation_is_the_plain_formula():
     """
     rng = np.random.default_rng(8)
     curves = universal_curves()
-    for grid in (curves._table_a, curves._table_b):
+    for grid in (curves.table_a, curves.table_b):
         nx, ny = grid.nx, grid.ny
         tables = grid.cells[:, :, 0].T.reshape(grid.k, nx, ny)  # c0 of each cell is the table itself
-        test_grid = curves_module._Grid(tables, 1.0, 2.0, -3.0, 0.5)
+        test_grid = curves_module.BilinearGrid(tables, 1.0, 2.0, -3.0, 0.5)
         # Inside the grid and beyond its edges (clamped).
         x = rng.uniform(-5.0, nx + 5.0, 5000) * 2.0 + 1.0
         y = rng.uniform(-5.0, ny + 5.0, 5000) * 0.5 - 3.0
@@ -1025,7 +1025,7 @@ def test_vector_env_uses_the_curves_not_a_copy(monkeypatch):
         return vec.step(np.full(32, 2, dtype=np.int64))[0]  # burns too
 
     before = first_step()
-    cells = universal_curves()._table_b.cells  # what the compiled loops read (orbit_env.envs.kernel)
+    cells = universal_curves().table_b.cells  # what the compiled loops read (orbit_env.envs.kernel)
     saved = cells.copy()
     try:
         cells[..., 0] *= 1.001

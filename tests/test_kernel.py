@@ -19,6 +19,7 @@ The cells of table B (which cell each orbit is in) and the episode ends must be 
 
 from __future__ import annotations
 
+import inspect
 import math
 
 import gymnasium as gym
@@ -26,11 +27,14 @@ import numpy as np
 import pytest
 
 import orbit_env  # noqa: F401  (registers the environments)
-from orbit_env.constants import TWO_PI
+from orbit_env.constants import EARTH_RADIUS_M, SECONDS_PER_DAY, TWO_PI
+from orbit_env.decay.curves import GridScales, grid_cell, universal_curves
 from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig
 from orbit_env.envs import kernel as kernel_module
 from orbit_env.envs import task as task_model
-from orbit_env.envs.task import STATE_FIELDS, Task
+from orbit_env.envs.kernel import KernelParameters
+from orbit_env.envs.state_layout import ROW, SEGMENT_ROW, SEGMENT_ROWS, STATE_FIELDS, StateFields
+from orbit_env.envs.task import Task
 
 pytestmark = pytest.mark.skipif(kernel_module.compiled() is None, reason="needs numba (and ORBIT_ENV_JIT not 0)")
 
@@ -49,16 +53,107 @@ def _requests(task: Task, rng: np.random.Generator, n: int) -> np.ndarray:
     return task.requested_dvs(rng.integers(0, len(task.config.burn_sizes_m_s), n), n)
 
 
-def test_state_rows_are_the_kernels() -> None:
-    assert STATE_FIELDS.index("label") == kernel_module._LABEL
-    for name, row in (
-        ("apogee_m", "_APOGEE"),
-        ("mass_kg", "_MASS"),
-        ("nu_per_rev", "_NU_PER_REV"),
-        ("steps", "_STEPS"),
-    ):
-        assert STATE_FIELDS.index(name) == getattr(kernel_module, row), name
-    assert kernel_module._SEGMENT == len(STATE_FIELDS)
+def test_every_state_row_is_its_fields() -> None:
+    """The rows the loops read (`state_layout.ROW`) are the rows `BatchState` keeps each field in."""
+    assert STATE_FIELDS == StateFields._fields and len(set(ROW)) == len(STATE_FIELDS)
+    state = task_model.start(TASKS["uncertain"], np.random.default_rng(2), 5)
+    for name in STATE_FIELDS:
+        row = getattr(ROW, name)
+        assert np.shares_memory(getattr(state, name), state.data[row]), name
+        np.testing.assert_array_equal(getattr(state, name), state.data[row], err_msg=name)
+    assert np.shares_memory(state.segments, state.data[SEGMENT_ROW:])
+    assert state.data.shape[0] == SEGMENT_ROW + SEGMENT_ROWS == len(STATE_FIELDS) + 1 + 2 * 3  # j, 3 bases, 3 slopes
+
+
+@pytest.mark.parametrize("name", list(TASKS))
+def test_every_kernel_parameter_is_the_tasks(name: str) -> None:
+    task = TASKS[name]
+    config, density = task.config, task.density
+    expected = {
+        "revolutions_per_step": config.revolutions_per_step,
+        "propellant_cost_per_m_s": config.propellant_cost_per_m_s,
+        "horizon_steps": config.horizon_steps,
+        "nominal_scale_s_per_day": density.nominal_scale * SECONDS_PER_DAY,
+        "density_varies": float(density.varies),
+        "cycle_amplitude": density.cycle_amplitude,
+        "cycle_period_days": density.cycle_period_days,
+        "per_height_scale_m": 1.0 / task_model.HEIGHT_SCALE_M,
+        "per_dv_scale_m_s": 1.0 / task_model.DV_SCALE_M_S,
+        "lifetime_scale_days": task_model.LIFETIME_SCALE_DAYS,
+        "apogee_drop_scale_m": task_model.APOGEE_DROP_SCALE_M,
+        "perigee_drop_scale_m": task_model.PERIGEE_DROP_SCALE_M,
+    }
+    parameters = task_model.kernel_parameters(task)
+    assert parameters.dtype == np.float64 and parameters.shape == (len(KernelParameters._fields),)
+    assert KernelParameters(*parameters.tolist())._asdict() == expected
+    for field, value in expected.items():  # at the index the loops read it from
+        assert parameters[getattr(kernel_module._P, field)] == value, field
+
+
+def test_every_grid_scale_is_the_grids() -> None:
+    curves = universal_curves()
+    for grid in (curves.table_a, curves.table_b):
+        scales = kernel_module._tables(curves)[1 if grid is curves.table_a else 3]
+        for field in GridScales._fields:
+            assert scales[getattr(kernel_module._G, field)] == getattr(grid, field), field
+    # grid_cell takes a GridScales after (x, y), in its order (``grid_cell(x, y, *scales)``).
+    assert tuple(inspect.signature(grid_cell).parameters)[2:] == GridScales._fields
+
+
+@pytest.fixture(scope="module")
+def compiled_lookups():
+    """The loops' lookups on one point, compiled alone: where it falls, table A's point, a new cell of table B."""
+    numba = pytest.importorskip("numba")
+    kernel_module.compiled()  # registers the helpers the lookups call
+
+    def cell(grid, x, y):
+        return kernel_module._cell(grid, x, y)
+
+    def table_a_point(perigee_m, apogee_m, cells, grid):
+        return kernel_module._table_a_point(perigee_m, apogee_m, cells, grid)
+
+    def new_segment(data, cells, grid, label, tau):
+        return kernel_module._new_segment(data, 0, cells, grid, label, tau)
+
+    return tuple(numba.njit(f) for f in (cell, table_a_point, new_segment))
+
+
+def test_the_curve_lookups_agree_bit_for_bit(compiled_lookups) -> None:
+    """The one-point lookups of the single env (Python), the vector env's loops (numba) and numpy's, equal.
+
+    `grid_cell` is written once (Python and compiled); the bilinear forms after it are written
+    in `BilinearGrid` (numpy and scalar) and in the loops: held equal here, bit for bit, at
+    random points inside the tables and beyond their edges (clamped).
+    """
+    cell, table_a_point, new_segment = compiled_lookups
+    rng = np.random.default_rng(12)
+    curves = universal_curves()
+    a, b = curves.table_a, curves.table_b
+    a_cells, a_scales, b_cells, b_scales = kernel_module._tables(curves)
+    n = 3000
+    # Table A over (perigee, ln e); table B over (label, tau): a margin beyond each edge.
+    hp = rng.uniform(50e3, 1300e3, n)
+    e = np.exp(rng.uniform(-35.0, np.log(0.3), n))
+    apogee = (EARTH_RADIUS_M + hp) * (1.0 + e) / (1.0 - e) - EARTH_RADIUS_M
+    label = rng.uniform(curves.labels[0] - 1.0, curves.labels[-1] + 1.0, n)
+    tau = rng.uniform(-1.0, 28.0, n)
+    for grid, scales, xs, ys in ((a, a_scales, hp, np.log(e)), (b, b_scales, label, tau)):
+        many = grid.values(xs, ys)
+        for i in range(n):
+            x, y = float(xs[i]), float(ys[i])
+            assert cell(scales, x, y) == grid_cell(x, y, *grid.scales)
+            assert grid.values_scalar(x, y) == [float(v[i]) for v in many]
+    located = curves.locate(hp, apogee)
+    data = np.zeros((SEGMENT_ROW + SEGMENT_ROWS, 1))
+    segments, ty = b.segments(label, tau)
+    for i in range(n):
+        point = curves.locate(float(hp[i]), float(apogee[i]))
+        assert (point.label, point.tau) == (float(located.label[i]), float(located.tau[i]))
+        assert table_a_point(float(hp[i]), float(apogee[i]), a_cells, a_scales) == (point.label, point.tau)
+        segment, ty_scalar = b.segment_scalar(float(label[i]), float(tau[i]))
+        assert segment == segments[:, i].tolist() and ty_scalar == ty[i]
+        assert new_segment(data, b_cells, b_scales, float(label[i]), float(tau[i])) == ty_scalar
+        assert data[SEGMENT_ROW:, 0].tolist() == segment
 
 
 def _numpy_step(task: Task, state: task_model.BatchState, requested: np.ndarray) -> task_model.StepResult:
@@ -118,9 +213,12 @@ def test_sine() -> None:
     period_days = 365.0
     time_days = x * (period_days / TWO_PI)
     angle = TWO_PI * time_days / period_days  # the loop's angle, as it computes it (phase 0)
-    parameters = np.zeros(12)
-    parameters[kernel_module._AMPLITUDE] = 1.0  # the exponent is the sine itself
-    parameters[kernel_module._PERIOD_DAYS] = period_days
+    parameters = np.array(
+        KernelParameters(**dict.fromkeys(KernelParameters._fields, 0.0))._replace(
+            cycle_amplitude=1.0,  # the exponent is the sine itself
+            cycle_period_days=period_days,
+        )
+    )
     near, far = slice(0, -3), slice(-3, None)
     for part in (near, far):
         out = np.empty(time_days[part].size)

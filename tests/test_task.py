@@ -77,7 +77,7 @@ def test_vector_env_dp_greedy_and_shaping_share_the_transition_bit_for_bit():
     assert result.terminated.any() and (result.burn_m_s > 0).any() and (result.burn_m_s < requested).any()
 
     # The DP's transition (its model of the known-density task) from the same states.
-    model = dp._Model(task.config, 1.0)
+    model = dp.DPModel(task.config, 1.0)
     for size in np.unique(requested):
         rows = requested == size
         step = model.step(start.take(rows), float(size))

@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -83,7 +83,53 @@ def _eccentricity(perigee_m: FloatArray, apogee_m: FloatArray) -> FloatArray:
     return (ra - rp) / (ra + rp)
 
 
-class _Grid:
+class GridScales(NamedTuple):
+    """Where a point (x, y) falls on a `BilinearGrid`: the cell coordinates fx = x x_scale - x_offset and fy.
+
+    ``ny`` is the grid's size in y (a cell's row in ``cells`` is i ny + j), ``x_top`` and ``y_top``
+    the largest cell coordinates, where the clamps stop. Floats, so that the compiled loops of
+    `orbit_env.envs.kernel` read them as one float64 array (``np.array(scales)``).
+    """
+
+    ny: float
+    x_scale: float
+    x_offset: float
+    y_scale: float
+    y_offset: float
+    x_top: float
+    y_top: float
+
+
+def grid_cell(
+    x: float,
+    y: float,
+    ny: float,
+    x_scale: float,
+    x_offset: float,
+    y_scale: float,
+    y_offset: float,
+    x_top: float,
+    y_top: float,
+) -> tuple[int, float, int, float]:
+    """One point's cell of a grid (clamped to it): its row in the cells, tx, the y index j, ty.
+
+    The arguments after (x, y) are a `GridScales`, in its order (``grid_cell(x, y, *scales)``).
+    Plain floats and no numpy, so that it is both the single environment's lookup
+    (`BilinearGrid.values_scalar`, `BilinearGrid.segment_scalar`) and, compiled by numba,
+    the vector environment's (`orbit_env.envs.kernel`): one definition of where a point
+    falls. The same operations in the same order as `BilinearGrid`'s array path.
+    """
+    fx = min(max(x * x_scale - x_offset, 0.0), x_top)
+    fy = y * y_scale
+    if y_offset != 0.0:
+        fy -= y_offset
+    fy = min(max(fy, 0.0), y_top)
+    i = int(fx)
+    j = int(fy)
+    return i * int(ny) + j, fx - i, j, fy - j
+
+
+class BilinearGrid:
     """Bilinear interpolation of a stack of tables (k, nx, ny) on a regular grid, clamped at its edges.
 
     Each cell stores the four coefficients of its bilinear form,
@@ -107,6 +153,16 @@ class _Grid:
         self.x_scale, self.x_offset = 1.0 / dx, x0 / dx
         self.y_scale, self.y_offset = 1.0 / dy, y0 / dy
         self.x_top, self.y_top = nx - 1.000001, ny - 1.000001
+        #: Where a point falls (`grid_cell`), as one tuple.
+        self.scales = GridScales(
+            ny=float(ny),
+            x_scale=self.x_scale,
+            x_offset=self.x_offset,
+            y_scale=self.y_scale,
+            y_offset=self.y_offset,
+            x_top=self.x_top,
+            y_top=self.y_top,
+        )
 
     def _cells(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, NDArray[np.intp], FloatArray]:
         """Each point's cell (clamped to the grid): its coefficients (..., k, 4), tx, the y index j, ty."""
@@ -191,15 +247,10 @@ class _Grid:
         The single environment steps one orbit at a time, where numpy's per-call
         cost on 0-d arrays is ten times the arithmetic.
         """
-        fx = min(max(x * self.x_scale - self.x_offset, 0.0), self.x_top)
-        fy = min(max(y * self.y_scale - self.y_offset, 0.0), self.y_top)
-        i = int(fx)
-        tx = fx - i
-        j = int(fy)
-        ty = fy - j
+        row, tx, _, ty = grid_cell(x, y, *self.scales)
         txy = tx * ty
         # The cell's coefficients as Python floats in one call (item() per number costs four times more).
-        return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[i * self.ny + j].tolist()]
+        return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[row].tolist()]
 
     def segment_scalar(self, x: float, y: float) -> tuple[list[float], float]:
         """`segments` for one point, in plain floats: the list [j, bases..., slopes...], and ty.
@@ -207,18 +258,11 @@ class _Grid:
         The same operations in the same order as `segments`, so the single
         environment's orbit follows the same lines as a vector environment's, bit for bit.
         """
-        fx = min(max(x * self.x_scale - self.x_offset, 0.0), self.x_top)
-        fy = y * self.y_scale
-        if self.y_offset:
-            fy -= self.y_offset
-        fy = min(max(fy, 0.0), self.y_top)
-        i = int(fx)
-        tx = fx - i
-        j = int(fy)
-        cell = self.cells[i * self.ny + j].tolist()
+        row, tx, j, ty = grid_cell(x, y, *self.scales)
+        cell = self.cells[row].tolist()
         bases = [c1 * tx + c0 for c0, c1, _, _ in cell]
         slopes = [c3 * tx + c2 for _, _, c2, c3 in cell]
-        return [float(j), *bases, *slopes], fy - j
+        return [float(j), *bases, *slopes], ty
 
     def on_segment_scalar(self, segment: list[float], x: float, y: float) -> float:
         """`on_segments` for one point: how far across its cell ``y`` is, ty.
@@ -337,9 +381,9 @@ def _heights_scalar(mu: float, b0: float, b1: float, q: float) -> tuple[float, f
 
 
 def _heights_along(mu: float, segment: list[float], ty: float) -> tuple[float, float, float]:
-    """`_heights` of table B's values at ``ty`` across one orbit's kept cell (`_Grid.segment_scalar`).
+    """`_heights` of table B's values at ``ty`` across one orbit's kept cell (`BilinearGrid.segment_scalar`).
 
-    The arithmetic of ``_heights(mu, *_Grid.along(...))``, unrolled for table B's three values.
+    The arithmetic of ``_heights(mu, *BilinearGrid.along(...))``, unrolled for table B's three values.
     """
     _, hp_base, y_base, q_base, hp_slope, y_slope, q_slope = segment
     hp = max(hp_slope * ty + hp_base, REENTRY_ALTITUDE_M)
@@ -374,14 +418,12 @@ class CurvePoint:
         """W = Int P dnu left [s m^3/(kg s^2)]; the time left is W / (g c s)."""
         return self.mean_period_s * self.nu
 
-    def _known_nu(self, nu: FloatArray) -> CurvePoint:
-        """This point with ``nu`` (from which its tau was computed) filled in, not recomputed from tau."""
-        self.__dict__["nu"] = nu  # the cached property's slot (a frozen dataclass: no setattr)
-        return self
-
     @classmethod
-    def _with_nu(cls, label: FloatArray, tau: FloatArray, mean_period_s: FloatArray, nu: FloatArray) -> CurvePoint:
-        """A point with its nu known, made without the frozen dataclass's checked __init__ (the envs' hot path)."""
+    def with_nu(cls, label: FloatArray, tau: FloatArray, mean_period_s: FloatArray, nu: FloatArray) -> CurvePoint:
+        """A point whose nu is known (tau was computed from it): nu is not recomputed from tau.
+
+        Made without the frozen dataclass's checked ``__init__``: the environments' hot path.
+        """
         point = object.__new__(cls)
         point.__dict__.update(label=label, tau=tau, mean_period_s=mean_period_s, nu=nu)
         return point
@@ -413,6 +455,13 @@ class UniversalCurves:
     (results equal to 1e-12 relative; only ``math`` versus numpy ``exp``/``log``
     may differ in the last bit). It exists for the single environment, which
     steps one orbit at a time.
+
+    Attributes:
+        model: The decay model the curves are of.
+        labels: The curves' labels mu, one every 0.1.
+        table_a: Over (perigee height [m], ln e): mu - ln e and tau (`BilinearGrid`).
+        table_b: Over (mu, tau): perigee height [m], ln e - mu and the mean period q [s]; the
+            compiled loops of `orbit_env.envs.kernel` read its cells and those of table A.
     """
 
     def __init__(self, model: DecayModel) -> None:
@@ -425,9 +474,9 @@ class UniversalCurves:
             tables = self._build()
             cache.store("curves", description, tables)
         label0 = float(self.labels[0])
-        self._table_a = _Grid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
-        self._table_b = _Grid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
-        self._table_q = _Grid(tables["b"][2:], label0, _LABEL_SPACING, 0.0, _DTAU)  # the mean period alone
+        self.table_a = BilinearGrid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
+        self.table_b = BilinearGrid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
+        self._table_q = BilinearGrid(tables["b"][2:], label0, _LABEL_SPACING, 0.0, _DTAU)  # the mean period alone
 
     def _build(self) -> dict[str, FloatArray]:
         """Integrate the family and make its two tables: A (orbit -> curve, place) and B (curve, place -> orbit)."""
@@ -581,7 +630,7 @@ class UniversalCurves:
         step by two operations per value. Locate anew the orbits whose label
         changed (a burn: `relocate_segments`); cell changes are handled by ``advance_heights``.
 
-        For two floats (one orbit): floats, and the cell as a list (`_Grid.segment_scalar`).
+        For two floats (one orbit): floats, and the cell as a list (`BilinearGrid.segment_scalar`).
         """
         return self._segments_at(*self._label_tau(perigee_m, apogee_m))
 
@@ -617,11 +666,11 @@ class UniversalCurves:
     def _segments_at(self, label: Any, tau: Any) -> tuple[CurvePoint, Any, Any, Any]:
         """The point (label, tau), its heights and its cell of table B (see `locate_segments`)."""
         if isinstance(label, float) and isinstance(tau, float):
-            segment, ty_s = self._table_b.segment_scalar(label, tau)
+            segment, ty_s = self.table_b.segment_scalar(label, tau)
             hp_s, ha_s, q_s = _heights_along(label, segment, ty_s)
             return CurvePoint(label=label, tau=tau, mean_period_s=q_s), hp_s, ha_s, segment
-        segments, ty = self._table_b.segments(label, tau)
-        perigee, apogee, q = _heights(label, *self._table_b.along(segments, ty))
+        segments, ty = self.table_b.segments(label, tau)
+        perigee, apogee, q = _heights(label, *self.table_b.along(segments, ty))
         return CurvePoint(label=label, tau=tau, mean_period_s=q), perigee, apogee, segments
 
     def locate_exactly(self, perigee_m: ArrayLike, apogee_m: ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -644,7 +693,7 @@ class UniversalCurves:
         step = 1e-7
 
         def residuals(mu: FloatArray, t: FloatArray) -> tuple[FloatArray, FloatArray]:
-            b0, b1, _ = self._table_b.values(mu, t)
+            b0, b1, _ = self.table_b.values(mu, t)
             return b0 - hp, b1 + mu - y
 
         for _ in range(LOCATE_NEWTON_STEPS):
@@ -667,12 +716,12 @@ class UniversalCurves:
         if isinstance(perigee_m, float) and isinstance(apogee_m, float):
             hp_m = float(perigee_m)
             y_s = math.log(max(_eccentricity(hp_m, float(apogee_m)), E_FLOOR))
-            a0, a1 = self._table_a.values_scalar(hp_m, y_s)
+            a0, a1 = self.table_a.values_scalar(hp_m, y_s)
             return y_s + a0, max(a1, 0.0)
         hp = np.asarray(perigee_m, dtype=np.float64)
         y = np.log(np.maximum(_eccentricity(hp, np.asarray(apogee_m, dtype=np.float64)), E_FLOOR))
         # Table A holds mu - ln(e), exact for orbits below its lowest row (translates).
-        a0, a1 = self._table_a.values(hp, y)
+        a0, a1 = self.table_a.values(hp, y)
         return y + a0, np.maximum(a1, 0.0)
 
     def _with_period(self, label: FloatArray, tau: FloatArray) -> CurvePoint:
@@ -688,11 +737,11 @@ class UniversalCurves:
         if isinstance(label, float) and isinstance(tau, float):
             return self._at_scalar(float(label), float(tau))
         mu = np.asarray(label, dtype=np.float64)
-        return _heights(mu, *self._table_b.values(mu, tau))
+        return _heights(mu, *self.table_b.values(mu, tau))
 
     def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
         """`at` for one orbit, in plain floats (the arithmetic of `_heights`)."""
-        return _heights_scalar(mu, *self._table_b.values_scalar(mu, tau))
+        return _heights_scalar(mu, *self.table_b.values_scalar(mu, tau))
 
     def _after(self, point: CurvePoint, dnu: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """The (nu, tau) reached once nu has fallen by ``dnu``, clamped at re-entry (nu = tau = 0)."""
@@ -706,7 +755,7 @@ class UniversalCurves:
         """Move along the curves by ``dnu`` of the universal variable (clamped at re-entry)."""
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
-        return self._with_period(label, tau)._known_nu(nu)
+        return CurvePoint.with_nu(label, tau, self._with_period(label, tau).mean_period_s, nu)
 
     def advance_heights(
         self, point: CurvePoint, dnu: ArrayLike, segments: FloatArray | None = None
@@ -727,16 +776,16 @@ class UniversalCurves:
             if segments is None:
                 hp_s, ha_s, q_s = self._at_scalar(label_s, tau_s)
             else:
-                ty_s = self._table_b.on_segment_scalar(segments, label_s, tau_s)
+                ty_s = self.table_b.on_segment_scalar(segments, label_s, tau_s)
                 hp_s, ha_s, q_s = _heights_along(label_s, segments, ty_s)
-            return CurvePoint._with_nu(label_s, tau_s, q_s, nu_s), hp_s, ha_s
+            return CurvePoint.with_nu(label_s, tau_s, q_s, nu_s), hp_s, ha_s
         nu, tau = self._after(point, dnu)
         label = float(point.label) if isinstance(tau, float) else np.asarray(point.label, dtype=np.float64)
         if segments is None:
             perigee_m, apogee_m, q = self.at(label, tau)
         else:
-            perigee_m, apogee_m, q = _heights(label, *self._table_b.on_segments(segments, label, tau))
-        return CurvePoint._with_nu(label, tau, q, nu), perigee_m, apogee_m
+            perigee_m, apogee_m, q = _heights(label, *self.table_b.on_segments(segments, label, tau))
+        return CurvePoint.with_nu(label, tau, q, nu), perigee_m, apogee_m
 
 
 def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0) -> FloatArray:

@@ -1,29 +1,33 @@
-"""The burns of a batch, compiled: one loop over the satellites that burn (numba).
+"""A vector environment's step, compiled: loops over the satellites (numba).
 
-A vector environment's step (`orbit_env.envs.task.step` on a
-`~orbit_env.envs.task.BatchState`) coasts every satellite in about 40 whole-batch
-numpy operations, which numpy runs in SIMD; but the few dozen satellites that burn
-in a step (the rocket equation, the vis-viva burn, the apogee cap, the new drag
-rates and the new place on the curves) cost some 140 numpy calls on that small
-subset, each 0.5-1 us whatever its size. Those calls, not the arithmetic, kept the
-vector environment behind Gymnasium's ``CartPoleVectorEnv``. `burn_rows` does those
-burns as one compiled loop over the satellites that burn, with the formulas of
-`orbit_env.envs.task.burn` in the same order, on the same state array and the same
-tables of the universal curves (`orbit_env.decay.curves`). The coast stays numpy's:
-compiled one satellite at a time, its ``exp`` and ``log1p`` calls cost twice numpy's
-SIMD (measured: 79 us against about 40 us for 4096 orbits).
+`orbit_env.envs.task.step_and_observe` on a `~orbit_env.envs.task.BatchState` runs
+here where numba is installed. `burn_rows` burns the satellites that burn (the rocket
+equation, the vis-viva burn, the apogee cap, the new drag rates and the new place on the
+curves) in one loop instead of some 140 numpy calls on a small subset, each 0.5-1 us
+whatever its size; `coast_and_observe` coasts every satellite and computes its reward,
+episode end and observation in three loops, with numpy's SIMD ``exp`` and ``log1p``
+between them (the C library's, one number at a time in a loop, cost twice as much).
+The formulas are `orbit_env.envs.task`'s, in the same order, on the same state array and
+the same tables of the universal curves (`orbit_env.decay.curves`).
 
-The numpy task model stays the definition and the fallback: `orbit_env.envs.task.burn`
-takes it when numba is not installed, when ``ORBIT_ENV_JIT=0`` is set, or for more
-than `MAX_COMPILED_ROWS` burning satellites (where numpy's SIMD wins).
-``tests/test_kernel.py`` steps both side by side through random burns, the apogee cap,
-empty tanks, re-entries and restarts of every variant and holds them equal to round-off
-(the only differences are the last bits of ``exp``, ``log``, ``expm1`` and ``sin``,
-the C library's against numpy's; the single environment's floats differ the same way).
+The contract with the task model is declared once: the state's rows are
+`orbit_env.envs.state_layout.ROW`, the task's numbers `KernelParameters`, a table's scales
+`orbit_env.decay.curves.GridScales`, and where a point falls on a table is
+`orbit_env.decay.curves.grid_cell`, the same function the single environment calls.
 
-Compiling takes about 5 seconds once (measured on the 2-core machine); numba keeps the machine code in its cache
-(``__pycache__`` beside this file, or ``NUMBA_CACHE_DIR``), and later processes load
-it in a fraction of a second.
+The numpy task model stays the definition and the fallback: `orbit_env.envs.task` steps
+with it when numba is not installed, when ``ORBIT_ENV_JIT=0`` is set, or for more than
+`MAX_COMPILED_ROWS` burning satellites (where numpy's SIMD wins). ``tests/test_kernel.py``
+steps both side by side through random burns, the apogee cap, empty tanks, re-entries and
+restarts of every variant and holds them equal to round-off (the only differences are the
+last bits of ``exp``, ``log``, ``expm1`` and ``sin``, the C library's against numpy's; the
+single environment's floats differ the same way), and holds every row, parameter and
+curve lookup equal.
+
+Compiling takes about 5 seconds once; numba keeps the machine code in its cache
+(``__pycache__`` beside this file, or ``NUMBA_CACHE_DIR``), and later processes load it in
+a fraction of a second. Numba checks only this file's date for that cache: after changing
+the declarations above (in their own modules) without changing this file, clear it.
 """
 
 from __future__ import annotations
@@ -37,7 +41,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
-from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, E_FLOOR, NU_REF, UniversalCurves
+from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, E_FLOOR, NU_REF, GridScales, UniversalCurves, grid_cell
+from orbit_env.envs.state_layout import ROW, SEGMENT_ROW
 
 FloatArray = NDArray[np.float64]
 
@@ -46,38 +51,51 @@ JIT_VARIABLE = "ORBIT_ENV_JIT"
 #: Above this many burning satellites in one call the numpy task model burns them (faster there).
 MAX_COMPILED_ROWS = 2048
 
-# Rows of a BatchState's array, in the order of task.STATE_FIELDS (tests/test_kernel.py checks
-# it); module constants, which numba freezes into the machine code.
-_LABEL, _TAU, _NU, _PERIOD, _PERIGEE, _APOGEE, _PERIGEE_DROP, _APOGEE_DROP = range(8)
-_MASS, _DRY, _EXHAUST, _AREA, _BASE, _PHASE, _SCALE, _NU_PER_REV = range(8, 16)
-_NOMINAL_W, _DV_LEFT, _TIME, _STEPS = range(16, 20)
-_SEGMENT = 20  # then the cell of table B: j, three bases, three slopes
 
-# Parameters of one table's grid, in a float array (see `_grid_parameters`).
-_NY, _X_SCALE, _X_OFFSET, _Y_SCALE, _Y_OFFSET, _X_TOP, _Y_TOP = range(7)
-# Parameters of the task, in a float array (`orbit_env.envs.task.kernel_parameters`).
-_REVOLUTIONS, _COST, _HORIZON, _NOMINAL_S_DAY, _VARIES, _AMPLITUDE, _PERIOD_DAYS = range(7)
-_HEIGHT_SCALE, _DV_SCALE, _LIFETIME_SCALE, _APOGEE_DROP_SCALE, _PERIGEE_DROP_SCALE = range(7, 12)
+class KernelParameters(NamedTuple):
+    """The task's numbers the compiled loops read (`orbit_env.envs.task.kernel_parameters` makes them)."""
+
+    revolutions_per_step: float  # K
+    propellant_cost_per_m_s: float  # [days per m/s]
+    horizon_steps: float
+    nominal_scale_s_per_day: float  # the nominal density scale x one day [s]
+    density_varies: float  # 1.0 if the density scale follows the cycle, else 0.0
+    cycle_amplitude: float  # A of s(t) = s0 exp(A sin(2 pi t / T + phi))
+    cycle_period_days: float  # T
+    per_height_scale_m: float  # 1 / HEIGHT_SCALE_M: the observation's scales, from here on
+    per_dv_scale_m_s: float  # 1 / DV_SCALE_M_S
+    lifetime_scale_days: float
+    apogee_drop_scale_m: float
+    perigee_drop_scale_m: float
 
 
-def _cell(cells: FloatArray, grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]:
-    """`_Grid._cells` for one point: its cell's row in ``cells``, tx, the y index j, ty."""
-    fx = min(max(x * grid[_X_SCALE] - grid[_X_OFFSET], 0.0), grid[_X_TOP])
-    fy = y * grid[_Y_SCALE]
-    if grid[_Y_OFFSET] != 0.0:
-        fy -= grid[_Y_OFFSET]
-    fy = min(max(fy, 0.0), grid[_Y_TOP])
-    i = int(fx)
-    j = int(fy)
-    return i * int(grid[_NY]) + j, fx - i, j, fy - j
+# The places of the state's rows, the task's numbers and a grid's scales in the arrays the loops
+# read, each from its one declaration. Module constants: numba freezes them into the machine code.
+_P = KernelParameters(*range(len(KernelParameters._fields)))
+_G = GridScales(*range(len(GridScales._fields)))
+
+
+def _cell(grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]:
+    """`grid_cell` of one point on a grid given by its `GridScales` as an array: row, tx, j, ty."""
+    return grid_cell(
+        x,
+        y,
+        ny=grid[_G.ny],
+        x_scale=grid[_G.x_scale],
+        x_offset=grid[_G.x_offset],
+        y_scale=grid[_G.y_scale],
+        y_offset=grid[_G.y_offset],
+        x_top=grid[_G.x_top],
+        y_top=grid[_G.y_top],
+    )
 
 
 def _table_a_point(perigee_m: float, apogee_m: float, a_cells: FloatArray, a_grid: FloatArray) -> tuple[float, float]:
-    """`UniversalCurves._label_tau` of one orbit: table A's (label, tau), bilinear (`_Grid.values`' grouping)."""
+    """`UniversalCurves.locate` of one orbit: table A's (label, tau), bilinear (`BilinearGrid.values_scalar`)."""
     rp = EARTH_RADIUS_M + perigee_m
     ra = EARTH_RADIUS_M + apogee_m
     y = math.log(max((ra - rp) / (ra + rp), E_FLOOR))
-    row, tx, _, ty = _cell(a_cells, a_grid, perigee_m, y)
+    row, tx, _, ty = _cell(a_grid, perigee_m, y)
     txy = tx * ty
     a0 = a_cells[row, 0, 1] * tx + a_cells[row, 0, 0] + a_cells[row, 0, 2] * ty + a_cells[row, 0, 3] * txy
     a1 = a_cells[row, 1, 1] * tx + a_cells[row, 1, 0] + a_cells[row, 1, 2] * ty + a_cells[row, 1, 3] * txy
@@ -94,36 +112,36 @@ def _relocate(
     b_grid: FloatArray,
 ) -> None:
     """`task.place_burnt` of row ``k``: moved by table A's difference, then label, tau, nu, period, heights, cell."""
-    perigee = data[_PERIGEE, k]
-    before_label, before_tau = _table_a_point(perigee, data[_APOGEE, k], a_cells, a_grid)
+    perigee = data[ROW.perigee_m, k]
+    before_label, before_tau = _table_a_point(perigee, data[ROW.apogee_m, k], a_cells, a_grid)
     after_label, after_tau = _table_a_point(perigee, apogee_after_m, a_cells, a_grid)
-    label = data[_LABEL, k] + (after_label - before_label)
-    tau = max(data[_TAU, k] + (after_tau - before_tau), 0.0)
-    data[_LABEL, k] = label
-    data[_TAU, k] = tau
-    data[_NU, k] = NU_REF * math.expm1(tau)
+    label = data[ROW.label, k] + (after_label - before_label)
+    tau = max(data[ROW.tau, k] + (after_tau - before_tau), 0.0)
+    data[ROW.label, k] = label
+    data[ROW.tau, k] = tau
+    data[ROW.nu, k] = NU_REF * math.expm1(tau)
     ty = _new_segment(data, k, b_cells, b_grid, label, tau)
     _heights_on_segment(data, k, label, ty)
 
 
 def _new_segment(data: FloatArray, k: int, b_cells: FloatArray, b_grid: FloatArray, label: float, tau: float) -> float:
-    """`_Grid.segments` of row ``k`` into its cell rows; returns ty."""
-    row, tx, j, ty = _cell(b_cells, b_grid, label, tau)
-    data[_SEGMENT, k] = j
+    """`BilinearGrid.segment_scalar` of row ``k`` into its cell rows; returns ty."""
+    row, tx, j, ty = _cell(b_grid, label, tau)
+    data[SEGMENT_ROW, k] = j
     for m in range(3):
-        data[_SEGMENT + 1 + m, k] = b_cells[row, m, 1] * tx + b_cells[row, m, 0]
-        data[_SEGMENT + 4 + m, k] = b_cells[row, m, 3] * tx + b_cells[row, m, 2]
+        data[SEGMENT_ROW + 1 + m, k] = b_cells[row, m, 1] * tx + b_cells[row, m, 0]
+        data[SEGMENT_ROW + 4 + m, k] = b_cells[row, m, 3] * tx + b_cells[row, m, 2]
     return ty
 
 
 def _heights_on_segment(data: FloatArray, k: int, label: float, ty: float) -> None:
     """`curves._heights` of table B's values ``ty`` across row ``k``'s cell: perigee, apogee, mean period."""
-    hp = max(data[_SEGMENT + 4, k] * ty + data[_SEGMENT + 1, k], REENTRY_ALTITUDE_M)
-    one_minus_e = 1.0 - math.exp(data[_SEGMENT + 5, k] * ty + data[_SEGMENT + 2, k] + label)
+    hp = max(data[SEGMENT_ROW + 4, k] * ty + data[SEGMENT_ROW + 1, k], REENTRY_ALTITUDE_M)
+    one_minus_e = 1.0 - math.exp(data[SEGMENT_ROW + 5, k] * ty + data[SEGMENT_ROW + 2, k] + label)
     rp = hp + EARTH_RADIUS_M
-    data[_PERIGEE, k] = hp
-    data[_APOGEE, k] = (rp + rp) / one_minus_e - rp - EARTH_RADIUS_M
-    data[_PERIOD, k] = data[_SEGMENT + 6, k] * ty + data[_SEGMENT + 3, k]
+    data[ROW.perigee_m, k] = hp
+    data[ROW.apogee_m, k] = (rp + rp) / one_minus_e - rp - EARTH_RADIUS_M
+    data[ROW.period_s, k] = data[SEGMENT_ROW + 6, k] * ty + data[SEGMENT_ROW + 3, k]
 
 
 def _perigee_speed_m_s(perigee_m: float, apogee_m: float) -> float:
@@ -145,17 +163,17 @@ def _apogee_after_m(perigee_m: float, apogee_m: float, dv_m_s: float) -> float:
 
 def _update_density(data: FloatArray, k: int, p: FloatArray) -> None:
     """`task.update_density` of row ``k``."""
-    scale = data[_BASE, k]
-    if p[_VARIES] != 0.0:
-        angle = TWO_PI * data[_TIME, k] / p[_PERIOD_DAYS] + data[_PHASE, k]
-        scale = scale * math.exp(p[_AMPLITUDE] * math.sin(angle))
+    scale = data[ROW.density_base, k]
+    if p[_P.density_varies] != 0.0:
+        angle = TWO_PI * data[ROW.time_days, k] / p[_P.cycle_period_days] + data[ROW.density_phase_rad, k]
+        scale = scale * math.exp(p[_P.cycle_amplitude] * math.sin(angle))
     _set_density_scale(data, k, scale)
 
 
 def _set_density_scale(data: FloatArray, k: int, scale: float) -> None:
     """Row ``k``'s density scale s(t) and its g c s per revolution (`task.update_density`'s last lines)."""
-    data[_SCALE, k] = scale
-    data[_NU_PER_REV, k] = G0_M_S2 * (data[_AREA, k] / data[_MASS, k] * scale)
+    data[ROW.density_scale, k] = scale
+    data[ROW.nu_per_rev, k] = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k] * scale)
 
 
 def _burn(
@@ -172,8 +190,8 @@ def _burn(
 
     `task.perigee_burn`, the new mass, `task.update_satellite` and `task.place_burnt`.
     """
-    mass, dry, exhaust = data[_MASS, k], data[_DRY, k], data[_EXHAUST, k]
-    perigee, apogee = data[_PERIGEE, k], data[_APOGEE, k]
+    mass, dry, exhaust = data[ROW.mass_kg, k], data[ROW.dry_mass_kg, k], data[ROW.exhaust_m_s, k]
+    perigee, apogee = data[ROW.perigee_m, k], data[ROW.apogee_m, k]
     dv_fuel = exhaust * math.log(mass / dry)
     dv = max(min(requested_m_s, dv_fuel), 0.0)
     apogee_after = _apogee_after_m(perigee, apogee, dv)
@@ -184,9 +202,9 @@ def _burn(
     if not dv > 0.0:
         return 0.0
     mass = dry if dv >= dv_fuel else max(mass / math.exp(dv / exhaust), dry)
-    data[_MASS, k] = mass
-    data[_DV_LEFT, k] = max(exhaust * math.log(mass / dry), 0.0)
-    data[_NOMINAL_W, k] = G0_M_S2 * (data[_AREA, k] / mass * p[_NOMINAL_S_DAY])
+    data[ROW.mass_kg, k] = mass
+    data[ROW.dv_left_m_s, k] = max(exhaust * math.log(mass / dry), 0.0)
+    data[ROW.nominal_w_per_day, k] = G0_M_S2 * (data[ROW.drag_area_m2, k] / mass * p[_P.nominal_scale_s_per_day])
     _update_density(data, k, p)
     _relocate(data, k, min(apogee_after, CURVES_MAX_APOGEE_M), a_cells, a_grid, b_cells, b_grid)
     return dv
@@ -241,7 +259,7 @@ def _sine(x: float) -> float:
 def _modulation_exponents(time_days: FloatArray, phase_rad: FloatArray, p: FloatArray, out: FloatArray) -> None:
     """A sin(2 pi t / T + phi) of every satellite: the exponent of `task.density_scale_at`."""
     # Locals, not reads of p in the loop: ``out`` could alias p, which would keep the loop scalar.
-    amplitude, period_days = p[_AMPLITUDE], p[_PERIOD_DAYS]
+    amplitude, period_days = p[_P.cycle_amplitude], p[_P.cycle_period_days]
     beyond = 0  # an integer count: a float reduction would not vectorize without fast-math
     for k in range(time_days.size):
         angle = TWO_PI * time_days[k] / period_days + phase_rad[k]
@@ -258,9 +276,9 @@ def _coast_start(data: FloatArray, p: FloatArray, modulation: FloatArray, nu_aft
     ``x`` gets nu / NU_REF, whose log1p is the new tau (`UniversalCurves._after`).
     """
     for k in range(data.shape[1]):
-        if p[_VARIES] != 0.0:
-            _set_density_scale(data, k, data[_BASE, k] * modulation[k])
-        nu = max(data[_NU, k] - p[_REVOLUTIONS] * data[_NU_PER_REV, k], 0.0)
+        if p[_P.density_varies] != 0.0:
+            _set_density_scale(data, k, data[ROW.density_base, k] * modulation[k])
+        nu = max(data[ROW.nu, k] - p[_P.revolutions_per_step] * data[ROW.nu_per_rev, k], 0.0)
         nu_after[k] = nu
         x[k] = nu * (1.0 / NU_REF)
 
@@ -273,16 +291,16 @@ def _coast_cells(
     ``exponent`` gets ln e - mu + mu along the cell, whose exp is e (`curves._heights`).
     """
     for k in range(data.shape[1]):
-        label = data[_LABEL, k]
-        ty = tau[k] * b_grid[_Y_SCALE]
-        if b_grid[_Y_OFFSET] != 0.0:
-            ty -= b_grid[_Y_OFFSET]
-        ty -= data[_SEGMENT, k]
+        label = data[ROW.label, k]
+        ty = tau[k] * b_grid[_G.y_scale]
+        if b_grid[_G.y_offset] != 0.0:
+            ty -= b_grid[_G.y_offset]
+        ty -= data[SEGMENT_ROW, k]
         if ty < 0.0 or ty > 1.0:  # left its cell (or a stale cell, j = -inf)
             ty = _new_segment(data, k, b_cells, b_grid, label, tau[k])
-        data[_TAU, k] = tau[k]
+        data[ROW.tau, k] = tau[k]
         tau[k] = ty
-        exponent[k] = data[_SEGMENT + 5, k] * ty + data[_SEGMENT + 2, k] + label
+        exponent[k] = data[SEGMENT_ROW + 5, k] * ty + data[SEGMENT_ROW + 2, k] + label
 
 
 def _coast_finish(
@@ -301,41 +319,34 @@ def _coast_finish(
     for k in range(data.shape[1]):
         ty = ty_all[k]
         nu = nu_after[k]
-        hp = max(data[_SEGMENT + 4, k] * ty + data[_SEGMENT + 1, k], REENTRY_ALTITUDE_M)
+        hp = max(data[SEGMENT_ROW + 4, k] * ty + data[SEGMENT_ROW + 1, k], REENTRY_ALTITUDE_M)
         rp = hp + EARTH_RADIUS_M
         apogee = (rp + rp) / (1.0 - eccentricity[k]) - rp - EARTH_RADIUS_M
-        period = data[_SEGMENT + 6, k] * ty + data[_SEGMENT + 3, k]
-        days = (data[_PERIOD, k] * data[_NU, k] - period * nu) / (data[_NU_PER_REV, k] * SECONDS_PER_DAY)
-        perigee_drop = data[_PERIGEE, k] - hp
-        apogee_drop = data[_APOGEE, k] - apogee
-        data[_PERIGEE_DROP, k] = perigee_drop
-        data[_APOGEE_DROP, k] = apogee_drop
-        data[_PERIGEE, k] = hp
-        data[_APOGEE, k] = apogee
-        data[_PERIOD, k] = period
-        data[_NU, k] = nu
-        data[_TIME, k] += days
-        steps = data[_STEPS, k] + 1.0
-        data[_STEPS, k] = steps
-        reward[k] = days - p[_COST] * made[k] if p[_COST] != 0.0 else days
-        terminated[k] = data[_TAU, k] <= 0.0
-        truncated[k] = steps >= p[_HORIZON]
+        period = data[SEGMENT_ROW + 6, k] * ty + data[SEGMENT_ROW + 3, k]
+        days = (data[ROW.period_s, k] * data[ROW.nu, k] - period * nu) / (data[ROW.nu_per_rev, k] * SECONDS_PER_DAY)
+        perigee_drop = data[ROW.perigee_m, k] - hp
+        apogee_drop = data[ROW.apogee_m, k] - apogee
+        data[ROW.perigee_drop_m, k] = perigee_drop
+        data[ROW.apogee_drop_m, k] = apogee_drop
+        data[ROW.perigee_m, k] = hp
+        data[ROW.apogee_m, k] = apogee
+        data[ROW.period_s, k] = period
+        data[ROW.nu, k] = nu
+        data[ROW.time_days, k] += days
+        steps = data[ROW.steps, k] + 1.0
+        data[ROW.steps, k] = steps
+        reward[k] = days - p[_P.propellant_cost_per_m_s] * made[k] if p[_P.propellant_cost_per_m_s] != 0.0 else days
+        terminated[k] = data[ROW.tau, k] <= 0.0
+        truncated[k] = steps >= p[_P.horizon_steps]
         # `task.observation` (a batch's clock is not clamped, as in `task.observe`).
-        life = period * nu / data[_NOMINAL_W, k]
-        obs[k, 0] = hp * p[_HEIGHT_SCALE]
-        obs[k, 1] = apogee * p[_HEIGHT_SCALE]
-        obs[k, 2] = data[_DV_LEFT, k] * p[_DV_SCALE]
-        obs[k, 3] = steps * (1.0 / p[_HORIZON])
-        obs[k, 4] = life / (life + p[_LIFETIME_SCALE])
-        obs[k, 5] = apogee_drop / (apogee_drop + p[_APOGEE_DROP_SCALE])
-        obs[k, 6] = perigee_drop / (perigee_drop + p[_PERIGEE_DROP_SCALE])
-
-
-def _grid_parameters(grid: Any) -> FloatArray:
-    """A `_Grid`'s scales and bounds, in the order of the ``_NY ... _Y_TOP`` indices."""
-    return np.array(
-        [grid.ny, grid.x_scale, grid.x_offset, grid.y_scale, grid.y_offset, grid.x_top, grid.y_top], dtype=np.float64
-    )
+        life = period * nu / data[ROW.nominal_w_per_day, k]
+        obs[k, 0] = hp * p[_P.per_height_scale_m]
+        obs[k, 1] = apogee * p[_P.per_height_scale_m]
+        obs[k, 2] = data[ROW.dv_left_m_s, k] * p[_P.per_dv_scale_m_s]
+        obs[k, 3] = steps * (1.0 / p[_P.horizon_steps])
+        obs[k, 4] = life / (life + p[_P.lifetime_scale_days])
+        obs[k, 5] = apogee_drop / (apogee_drop + p[_P.apogee_drop_scale_m])
+        obs[k, 6] = perigee_drop / (perigee_drop + p[_P.perigee_drop_scale_m])
 
 
 class _Kernels(NamedTuple):
@@ -360,7 +371,7 @@ def compiled() -> _Kernels | None:
         import numba
     except ImportError:
         return None
-    helpers = (_cell, _table_a_point, _relocate, _new_segment, _heights_on_segment)
+    helpers = (grid_cell, _cell, _table_a_point, _relocate, _new_segment, _heights_on_segment)
     helpers += (_perigee_speed_m_s, _apogee_after_m, _sine)
     for helper in (*helpers, _set_density_scale, _update_density, _burn):
         # Callable from the compiled loops, unchanged from Python. Not inlined by numba (that took the
@@ -372,9 +383,9 @@ def compiled() -> _Kernels | None:
 
 @lru_cache(maxsize=8)
 def _tables(curves: UniversalCurves) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Tables A and B of the curves as the loop reads them: cells (rows, k, 4) and grid parameters."""
-    a, b = curves._table_a, curves._table_b
-    return a.cells, _grid_parameters(a), b.cells, _grid_parameters(b)
+    """Tables A and B of the curves as the loops read them: cells (rows, k, 4) and `GridScales` as an array."""
+    a, b = curves.table_a, curves.table_b
+    return a.cells, np.array(a.scales, dtype=np.float64), b.cells, np.array(b.scales, dtype=np.float64)
 
 
 def burn_rows(
@@ -434,8 +445,8 @@ def coast_and_observe(
     n = state_data.shape[1]
     _, _, b_cells, b_grid = _tables(curves)
     first, second = np.empty(n), np.empty(n)
-    if parameters[_VARIES] != 0.0:
-        kernels.modulation_exponents(state_data[_TIME], state_data[_PHASE], parameters, first)
+    if parameters[_P.density_varies] != 0.0:
+        kernels.modulation_exponents(state_data[ROW.time_days], state_data[ROW.density_phase_rad], parameters, first)
         np.exp(first, out=first)
     nu_after = np.empty(n)
     kernels.coast_start(state_data, parameters, first, nu_after, second)

@@ -56,6 +56,7 @@ from orbit_env.envs.config import (
     OrbitRaisingConfig,
     validate_satellite,
 )
+from orbit_env.envs.state_layout import SEGMENT_ROW, SEGMENT_ROWS, STATE_FIELDS
 from orbit_env.physics.orbit import (
     apogee_after_perigee_burn_m,
     elements_from_heights,
@@ -280,38 +281,12 @@ class TaskView:
 # The state: Python floats for one satellite, rows of one array for many.
 # ---------------------------------------------------------------------------------
 
-#: The fields of a `TaskState`, in the order of a `BatchState`'s rows.
-STATE_FIELDS = (
-    "label",  # mu, the universal curve the orbit decays along
-    "tau",  # ln(1 + nu / NU_REF), the position along it
-    "nu",  # universal lifetime left [m^3/(kg s^2)]
-    "period_s",  # mean period over the rest of the decay, W / nu [s]
-    "perigee_m",  # heights as the curves give the point [m]
-    "apogee_m",
-    "perigee_drop_m",  # drops over the last coast [m] (0 at the start)
-    "apogee_drop_m",
-    "mass_kg",
-    "dry_mass_kg",
-    "exhaust_m_s",  # effective exhaust velocity Isp g0 [m/s]
-    "drag_area_m2",  # c_x F
-    "density_base",  # s0, the episode's density scale
-    "density_phase_rad",  # phi of the solar-cycle-like modulation
-    "density_scale",  # s(t), held over the coming step
-    "nu_per_rev",  # g c s per revolution [m^3/(kg s^2)]
-    "nominal_w_per_day",  # g c s_nominal x 1 day: W over it is the predicted lifetime [days]
-    "dv_left_m_s",  # delta-v the propellant on board still gives [m/s]
-    "time_days",  # mission time [days]
-    "steps",  # steps taken (whole numbers, exact in float64)
-)
-#: Rows below the fields in a `BatchState`: each orbit's cell of the curves' table B
-#: (``UniversalCurves.locate_segments``), kept between steps so a coast needs no gather.
-SEGMENT_ROWS = 7
 #: A cell index no orbit is in: the next coast makes the orbit's cell afresh.
 STALE_SEGMENT = -np.inf
 
 
 class TaskState:
-    """The state of one satellite: every field of `STATE_FIELDS` a Python float.
+    """The state of one satellite: every field of `STATE_FIELDS` (`orbit_env.envs.state_layout`) a Python float.
 
     The single environment steps one of these; the task functions read and assign
     its attributes exactly as they do a `BatchState`'s.
@@ -346,11 +321,11 @@ class BatchState:
     def __init__(self, data: FloatArray | int) -> None:
         if isinstance(data, (int, np.integer)):
             data = _staggered_rows(int(data))
-            data[len(STATE_FIELDS)] = STALE_SEGMENT
-        assert data.shape[0] == len(STATE_FIELDS) + SEGMENT_ROWS
+            data[SEGMENT_ROW] = STALE_SEGMENT
+        assert data.shape[0] == SEGMENT_ROW + SEGMENT_ROWS
         views = self.__dict__
         views.update(zip(STATE_FIELDS, data, strict=False))  # the rows as views, iterated in C
-        views["segments"] = data[len(STATE_FIELDS) :]
+        views["segments"] = data[SEGMENT_ROW:]
         views["data"] = data
 
     def __setattr__(self, name: str, value: Any) -> None:
@@ -413,7 +388,7 @@ def _staggered_rows(n: int) -> FloatArray:
     view into a wider array whose row length is an odd number of 64-byte lines, which
     spreads consecutive rows over distinct sets.
     """
-    rows = len(STATE_FIELDS) + SEGMENT_ROWS
+    rows = SEGMENT_ROW + SEGMENT_ROWS
     line = 64 // np.dtype(np.float64).itemsize
     width = -(-n // line) * line
     if (width // line) % 2 == 0:
@@ -846,7 +821,7 @@ def coast(task: Task, state: AnyState, steps: Any = 1.0) -> Any:
     weighted_s = state.period_s * state.nu  # W = q nu, as CurvePoint.weighted_s (not cached: cheaper)
     revolutions = task.config.revolutions_per_step * steps
     # The state's place on the curves, nu known (no expm1 of tau).
-    point = state.point if single else CurvePoint._with_nu(state.label, state.tau, state.period_s, state.nu)
+    point = state.point if single else CurvePoint.with_nu(state.label, state.tau, state.period_s, state.nu)
     after, perigee_m, apogee_m = task.curves.advance_heights(point, revolutions * state.nu_per_rev, state.segments)
     days = (weighted_s - after.mean_period_s * after.nu) / (state.nu_per_rev * SECONDS_PER_DAY)
     # The drops: heights before less heights after (on a batch's rows, written in place).
@@ -892,13 +867,23 @@ def step(task: Task, state: AnyState, requested_dv_m_s: Any) -> StepResult:
 
 @lru_cache(maxsize=16)
 def kernel_parameters(task: Task) -> FloatArray:
-    """The numbers of a task that the compiled loops (`orbit_env.envs.kernel`) read, in their order."""
+    """The numbers of a task that the compiled loops (`orbit_env.envs.kernel`) read: `kernel.KernelParameters`."""
     config, density = task.config, task.density
-    values = [config.revolutions_per_step, config.propellant_cost_per_m_s, config.horizon_steps]
-    values += [density.nominal_scale * SECONDS_PER_DAY, density.varies, density.cycle_amplitude]
-    values += [density.cycle_period_days, 1.0 / HEIGHT_SCALE_M, 1.0 / DV_SCALE_M_S]
-    values += [LIFETIME_SCALE_DAYS, APOGEE_DROP_SCALE_M, PERIGEE_DROP_SCALE_M]
-    return np.array(values, dtype=np.float64)
+    parameters = kernel.KernelParameters(
+        revolutions_per_step=config.revolutions_per_step,
+        propellant_cost_per_m_s=config.propellant_cost_per_m_s,
+        horizon_steps=config.horizon_steps,
+        nominal_scale_s_per_day=density.nominal_scale * SECONDS_PER_DAY,
+        density_varies=density.varies,
+        cycle_amplitude=density.cycle_amplitude,
+        cycle_period_days=density.cycle_period_days,
+        per_height_scale_m=1.0 / HEIGHT_SCALE_M,
+        per_dv_scale_m_s=1.0 / DV_SCALE_M_S,
+        lifetime_scale_days=LIFETIME_SCALE_DAYS,
+        apogee_drop_scale_m=APOGEE_DROP_SCALE_M,
+        perigee_drop_scale_m=PERIGEE_DROP_SCALE_M,
+    )
+    return np.array(parameters, dtype=np.float64)
 
 
 def step_and_observe(
