@@ -142,6 +142,10 @@ class Scenario:
             else ""
         )
         details += f" x {self.density_scale:g}" if self.density_scale != 1.0 else ""
+        if self.corotating:
+            details += ", co-rotating air"
+        elif self.air.corotates:
+            details += ", still air"
         return self.air.describe(inclination_deg, details)
 
     def lifetime_days(

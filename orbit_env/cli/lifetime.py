@@ -41,7 +41,10 @@ def _scenario(args: argparse.Namespace) -> Scenario:
             if model is not chosen and name not in chosen.options and given(args, name):
                 raise ValueError(f"{flag(name)} applies to --atmosphere {model.name}")
     air = chosen.from_options({name: getattr(args, name) for name in chosen.options})
-    rotating = True if args.rotating_atmosphere else None  # None: the model's own default
+    if args.rotating_atmosphere and args.still_air:
+        raise ValueError("give either --rotating-atmosphere or --still-air, not both")
+    # None: the model's own default (NRLMSIS co-rotates, the paper's and the exponential law are still).
+    rotating = True if args.rotating_atmosphere else (False if args.still_air else None)
     return Scenario(air, args.density_scale, rotating, args.chunk_days)
 
 
@@ -316,7 +319,14 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--node-local-time", type=number, metavar="HOURS", help="msis: Sun-synchronous node local time")
     group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")
-    group.add_argument("--rotating-atmosphere", action="store_true", help="air co-rotates with the Earth")
+    group.add_argument(
+        "--rotating-atmosphere",
+        action="store_true",
+        help="air co-rotates with the Earth (the default under msis; paper and exponential: still air)",
+    )
+    group.add_argument(
+        "--still-air", action="store_true", help="msis: air that does not turn with the Earth (to compare)"
+    )
     group.add_argument(
         "--inclination", type=number, metavar="DEG", help="inclination (rotating air; msis latitudes; default 0)"
     )
