@@ -98,6 +98,18 @@ def test_three_line_sets_blank_lines_and_space_track_names():
     assert sets[0].drag_parameter_m2_kg is None  # B* < 0: no drag parameter from it
 
 
+def test_element_sets_as_people_paste_them():
+    # Indented lines (copied from a web page or an e-mail), trailing spaces and tabs, CRLF line ends,
+    # no name line: the same two sets as the clean text.
+    clean = parse_tle_text([*ISS, *CUBESAT[1:]])
+    pasted = f"    {ISS[0]}   \r\n\t{ISS[1]}\t\r\n\r\n  {CUBESAT[1]}\r\n  {CUBESAT[2]}  \r\n"
+    sets = parse_tle_text(pasted.splitlines())
+    assert [(s.epoch_days, s.semi_major_axis_km, s.bstar_per_earth_radius) for s in sets] == [
+        (s.epoch_days, s.semi_major_axis_km, s.bstar_per_earth_radius) for s in clean
+    ]
+    assert [s.name for s in sets] == ["25544", "99999"]
+
+
 def test_mean_elements_heights_and_bounds():
     elements = mean_elements(6928.137, 0.001, 53.0)
     assert elements.perigee_km == pytest.approx(6928.137 * 0.999 - 6378.137)

@@ -181,13 +181,14 @@ _SGP4_ERRORS = {
 def parse_tle_text(lines: Iterable[str], source: str = "TLE") -> list[ElementSet]:
     """Every element set of a text in CelesTrak's format: two-line sets, or three-line sets with a name line.
 
-    Blank lines are skipped; a name line is any line that does not start with ``1 `` or
-    ``2 `` (a leading ``0 `` is dropped, as Space-Track writes it).
+    Text as people paste it is read: lines may be indented, end in spaces, tabs or CRLF,
+    and a set may have no name line. Blank lines are skipped; a name line is any line that
+    does not start with ``1 `` or ``2 `` (a leading ``0 `` is dropped, as Space-Track writes it).
 
     Raises:
-        ValueError: a malformed set (the message names the file's line), or no set at all.
+        ValueError: a malformed set (the message names the file's line and what is wrong), or no set at all.
     """
-    numbered = [(i + 1, text.rstrip("\r\n").rstrip()) for i, text in enumerate(lines)]
+    numbered = [(i + 1, text.strip()) for i, text in enumerate(lines)]
     numbered = [(i, text) for i, text in numbered if text.strip()]
     sets: list[ElementSet] = []
     k = 0
