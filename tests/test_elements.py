@@ -130,12 +130,15 @@ def test_cli_tle_json_reports_the_drag_parameter_and_its_source(capsys, tmp_path
     assert result["drag_parameter_source"] == "bstar"
     assert result["drag_parameter_m2_kg"] == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-12)
     assert result["height_reference"] == "equatorial"
-    assert result["perigee_km"] == pytest.approx(elements.perigee_km)
+    # The orbit flown: the mean elements' heights moved by J2's offset (+4.5 km at 97.5 deg).
+    assert result["perigee_km"] == pytest.approx(elements.flown_perigee_km)
+    assert result["mean_perigee_km"] == pytest.approx(elements.perigee_km)
+    assert result["flown_offset_km"] == pytest.approx(4.5, abs=0.2)
     assert result["inclination_deg"] == pytest.approx(97.5)
     # The same orbit through the API: heights onto the sphere, c = 2 B* / rho0 as c_x 1 on c m^2 per kg.
     api = lifetime(
-        elements.perigee_km + EQUATORIAL_OFFSET_KM,
-        elements.apogee_km + EQUATORIAL_OFFSET_KM,
+        elements.flown_perigee_km + EQUATORIAL_OFFSET_KM,
+        elements.flown_apogee_km + EQUATORIAL_OFFSET_KM,
         satellite=Satellite(1.0, 1.0, elements.drag_parameter_m2_kg),
         method="curves",  # the command line's default on the curves
     )
@@ -249,8 +252,8 @@ def test_batch_of_element_sets(capsys, tmp_path):
     rows = list(csv.DictReader(out.open()))
     assert [row["name"] for row in rows] == ["CUBESAT-550 (synthetic)", "ISS (ZARYA)"]
     elements = parse_tle(*CUBESAT[1:])
-    # Heights above the equatorial radius, as the sets give them; c from B*; the inclination from the set.
-    assert float(rows[0]["perigee_km"]) == pytest.approx(elements.perigee_km, abs=1e-3)
+    # Heights of the orbit flown above the equatorial radius; c from B*; the inclination from the set.
+    assert float(rows[0]["perigee_km"]) == pytest.approx(elements.flown_perigee_km, abs=1e-3)
     assert float(rows[0]["drag_parameter_m2_kg"]) == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-5)
     assert float(rows[0]["inclination_deg"]) == pytest.approx(97.5)
     assert rows[0]["status"] == "ok" and float(rows[0]["days"]) > 0
@@ -259,3 +262,44 @@ def test_batch_of_element_sets(capsys, tmp_path):
         rows[1]["status"].startswith("line 5: B* = -1.1606e-05 /ER gives no drag parameter") and rows[1]["days"] == ""
     )
     assert status == 1
+
+
+def sgp4_mean_heights_km(satrec, days=3.0):
+    """SGP4's own orbit over ``days`` (about 46 revolutions): the mean of r - 6378.137 km, and of the geodetic altitude.
+
+    The geodetic altitude to first order in the flattening f: r - a (1 - f sin^2(latitude)).
+    """
+    minutes = np.linspace(0.0, days * 1440.0, 40001)
+    error, r, _ = satrec.sgp4_array(np.full(minutes.size, satrec.jdsatepoch), satrec.jdsatepochF + minutes / 1440.0)
+    assert not np.any(error)
+    radius = np.linalg.norm(r, axis=1)
+    sin_latitude = r[:, 2] / radius
+    geodetic = radius - 6378.137 * (1.0 - sin_latitude**2 / 298.257223563)
+    return float(np.mean(radius - 6378.137)), float(np.mean(geodetic))
+
+
+@pytest.mark.parametrize("inclination_deg", [0.0, 28.5, 51.6, 97.5])
+def test_flown_heights_are_sgp4s_own_orbit_averaged(inclination_deg):
+    from sgp4.api import WGS72, Satrec
+
+    from orbit_env.analysis.elements import ElementSet
+    from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples
+
+    satrec = Satrec()
+    n_rad_min = 15.5 * 2 * math.pi / 1440.0  # about 390 km
+    satrec.sgp4init(
+        WGS72, "i", 1, 24000.0, 0.0, 0.0, 0.0, 0.0005, 0.5, math.radians(inclination_deg), 0.2, n_rad_min, 0.7
+    )
+    elements = ElementSet("test", None, satrec.a * satrec.radiusearthkm, satrec.ecco, inclination_deg)
+    mean_height, mean_geodetic = sgp4_mean_heights_km(satrec)
+    flown = 0.5 * (elements.flown_perigee_km + elements.flown_apogee_km)
+    # The J2 offset is -9.7 km at 0 deg, +4.6 at 97.5 deg; the first-order formula lands within 0.03 km of
+    # SGP4's mean (measured), so 0.1 km holds it and fails without the offset (0.8 km even at 51.6 deg).
+    assert flown == pytest.approx(mean_height, abs=0.1)
+    assert 0.5 * (elements.perigee_km + elements.apogee_km) != pytest.approx(mean_height, abs=0.5)
+    # The geodetic altitude the NRLMSIS profile is averaged at (its latitudes, the flown radius) against
+    # SGP4's orbit: the same 0.1 km plus 0.05 km for the 12-node latitude average.
+    latitude, _ = orbit_samples(inclination_deg)
+    sphere_height_m = (flown + 7.137) * 1e3
+    ours = float(np.mean(geodetic_altitude_m(sphere_height_m, latitude))) / 1e3
+    assert ours == pytest.approx(mean_geodetic, abs=0.15)

@@ -335,8 +335,10 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
 def add_parsers(sub: Any) -> None:
     """The ``lifetime`` and ``fit-density`` commands."""
     life = sub.add_parser("lifetime", help="lifetime of a satellite on an orbit, to re-entry at 100 km perigee")
-    life.add_argument("--perigee", type=number, metavar="KM", help="perigee height [km]")
-    life.add_argument("--apogee", type=number, metavar="KM", help="apogee height [km]")
+    life.add_argument(
+        "--perigee", type=number, metavar="KM", help="perigee height [km] of the orbit flown, above --height-reference"
+    )
+    life.add_argument("--apogee", type=number, metavar="KM", help="apogee height [km] of the orbit flown")
     orbit_inputs.add_orbit_options(life)
     _add_satellite_options(life, shapes=True)
     life.add_argument(

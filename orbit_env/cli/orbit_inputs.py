@@ -62,9 +62,17 @@ def add_orbit_options(parser: argparse.ArgumentParser) -> None:
     """``--tle``, ``--semi-major-axis-km``, ``--eccentricity``, ``--height-reference``."""
     group = parser.add_argument_group("orbit from elements")
     group.add_argument(
-        "--tle", metavar="FILE", help="two- or three-line element set ('-': stdin): epoch, orbit, inclination, B*"
+        "--tle",
+        metavar="FILE",
+        help="two- or three-line element set ('-': stdin): epoch, mean elements (the decay starts from the orbit "
+        "flown: J2's offset added), inclination, B*",
     )
-    group.add_argument("--semi-major-axis-km", type=number, metavar="KM", help="mean semi-major axis [km]")
+    group.add_argument(
+        "--semi-major-axis-km",
+        type=number,
+        metavar="KM",
+        help="mean semi-major axis [km] (SGP4's, Brouwer's; the decay starts from the orbit flown: J2's offset added)",
+    )
     group.add_argument("--eccentricity", type=number, metavar="E", help="mean eccentricity (with --semi-major-axis-km)")
     group.add_argument(
         "--height-reference",
@@ -129,7 +137,8 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
     if elements is not None:
         if reference != "equatorial":
             raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
-        return OrbitInput(elements.perigee_km, elements.apogee_km, reference, elements)
+        # Mean elements are not the orbit flown: the decay starts from the flown heights (J2's offset).
+        return OrbitInput(elements.flown_perigee_km, elements.flown_apogee_km, reference, elements)
     return OrbitInput(perigee, apogee, reference)
 
 
@@ -218,6 +227,9 @@ def elements_report(elements: Any, result: Any = None) -> dict[str, Any]:
     report: dict[str, Any] = {
         "semi_major_axis_km": elements.semi_major_axis_km,
         "eccentricity": elements.eccentricity,
+        "mean_perigee_km": elements.perigee_km,
+        "mean_apogee_km": elements.apogee_km,
+        "flown_offset_km": elements.flown_offset_km,
     }
     if elements.epoch_days is not None:
         report.update(name=elements.name, epoch=elements.epoch_iso)
@@ -238,9 +250,19 @@ def orbit_lines(orbit: OrbitInput, inclination_deg: float) -> list[str]:
             f"element set        {elements.name}, epoch {elements.epoch_iso}, inclination {inclination_deg:g} deg"
         )
     if elements is not None:
-        lines.append(f"mean elements      a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f}")
+        lines.append(
+            f"mean elements      a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f} "
+            f"({elements.perigee_km:.6g} x {elements.apogee_km:.6g} km)"
+        )
     assert orbit.perigee_km is not None and orbit.apogee_km is not None
-    lines.append(f"orbit              {orbit.perigee_km:.6g} x {orbit.apogee_km:.6g} km, {describe(orbit.reference)}")
+    flown = (
+        ""
+        if elements is None
+        else f" (flown: J2 moves the mean elements' radius by {elements.flown_offset_km:+.2f} km)"
+    )
+    lines.append(
+        f"orbit              {orbit.perigee_km:.6g} x {orbit.apogee_km:.6g} km, {describe(orbit.reference)}{flown}"
+    )
     return lines
 
 
@@ -300,8 +322,8 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any)
     sets = read_tle(args.batch)
     satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
     rows = [{"name": s.name} for s in sets]
-    hp = np.array([s.perigee_km for s in sets]) * 1e3 + offset_m
-    ha = np.array([s.apogee_km for s in sets]) * 1e3 + offset_m
+    hp = np.array([s.flown_perigee_km for s in sets]) * 1e3 + offset_m
+    ha = np.array([s.flown_apogee_km for s in sets]) * 1e3 + offset_m
     inc = np.array([s.inclination_deg for s in sets])
     c = np.full(len(sets), satellite.drag_parameter_m2_kg)
     status = ["ok"] * len(sets)
