@@ -43,7 +43,9 @@ from orbit_env.decay.curves import (
 )
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import BatchState, Task, perigee_burn, period_gain_days_per_m_s_per_step
+from orbit_env.envs.rocket import mass_from_delta_v_left_kg, perigee_burn, period_gain_days_per_m_s_per_step
+from orbit_env.envs.state import BatchState
+from orbit_env.envs.task import Task
 
 FloatArray = NDArray[np.float64]
 
@@ -151,7 +153,7 @@ class DPModel:
     def mass_kg(self, dv_left_m_s: FloatArray) -> FloatArray:
         """Mass from the delta-v left, by the rocket equation."""
         config = self.config
-        return task_model.mass_from_delta_v_left_kg(dv_left_m_s, config.dry_mass_kg, config.exhaust_velocity_m_s)
+        return mass_from_delta_v_left_kg(dv_left_m_s, config.dry_mass_kg, config.exhaust_velocity_m_s)
 
     def states(self, label: FloatArray, life: FloatArray, dv_left_m_s: FloatArray) -> BatchState:
         """Grid states: on curve ``label`` with ``life`` steps of life left at the mass ``dv_left_m_s`` gives."""

@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 
 from orbit_env.agents.dp import DPPolicy
 from orbit_env.envs import task as task_model
-from orbit_env.envs.task import BatchState
+from orbit_env.envs.state import BatchState
 
 FloatArray = NDArray[np.float64]
 

@@ -18,7 +18,8 @@ from numpy.typing import NDArray
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import BatchState, Task
+from orbit_env.envs.state import BatchState
+from orbit_env.envs.task import Task
 from orbit_env.physics.orbit import dv_for_apogee_m_s
 
 FloatArray = NDArray[np.float64]

@@ -59,7 +59,9 @@ except ImportError as error:  # pragma: no cover - depends on the installation
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig
-from orbit_env.envs.task import AnyState, Task, period_gain_days_per_m_s_per_step
+from orbit_env.envs.rocket import period_gain_days_per_m_s_per_step
+from orbit_env.envs.state import AnyState
+from orbit_env.envs.task import Task
 
 FloatArray = NDArray[np.float64]
 
@@ -84,7 +86,7 @@ def outlook(task: Task, state: AnyState) -> tuple[FloatArray, NDArray[np.bool_]]
 def period_gain_days_per_m_s(config: OrbitRaisingConfig) -> float:
     """The most mission days a perigee burn can add per m/s by lengthening the period alone.
 
-    `orbit_env.envs.task.period_gain_days_per_m_s_per_step` for each
+    `orbit_env.envs.rocket.period_gain_days_per_m_s_per_step` for each
     of the mission's steps.
     """
     return period_gain_days_per_m_s_per_step(config.revolutions_per_step) * config.horizon_steps

@@ -42,7 +42,8 @@ from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig, OrbitRais
 from orbit_env.envs import kernel as kernel_module
 from orbit_env.envs import orbit_raising as orbit_raising_module
 from orbit_env.envs.config import CONFIG_FIELDS, DEFAULT_HORIZON_STEPS, DENSITY_FIELDS, UNCERTAIN_DENSITY
-from orbit_env.envs.task import OBS_HIGH, delta_v_left_m_s
+from orbit_env.envs.rocket import delta_v_left_m_s
+from orbit_env.envs.task import OBS_HIGH
 from orbit_env.envs.vector import OrbitRaisingVectorEnv
 from orbit_env.physics.orbit import perigee_velocity_m_s
 

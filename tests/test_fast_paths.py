@@ -17,7 +17,9 @@ import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.decay.curves import universal_curves
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import Task, UniformBox
+from orbit_env.envs.spaces import UniformBox
+from orbit_env.envs.state import STATE_FIELDS
+from orbit_env.envs.task import Task
 
 ROUND_OFF = 1e-12
 
@@ -93,7 +95,7 @@ def test_single_env_follows_the_vector_env_over_a_mission():
         for i, single in enumerate(singles):
             one = task_model.step(task, single, task.config.burn_sizes_m_s[row[i]])
             assert one.reward == pytest.approx(float(many.reward[i]), rel=1e-9)  # a difference of W's
-            for name in task_model.STATE_FIELDS:
+            for name in STATE_FIELDS:
                 # A drop is a difference of two heights (up to 4000 km), each to round-off: absolute.
                 tolerance = 4000e3 * ROUND_OFF if name.endswith("_drop_m") else 1e-300
                 assert getattr(single, name) == pytest.approx(getattr(batch, name)[i], rel=ROUND_OFF, abs=tolerance)

@@ -33,7 +33,7 @@ from orbit_env.envs import ENV_IDS, DensityConfig, OrbitRaisingConfig
 from orbit_env.envs import kernel as kernel_module
 from orbit_env.envs import task as task_model
 from orbit_env.envs.kernel import KernelParameters
-from orbit_env.envs.state_layout import ROW, SEGMENT_ROW, SEGMENT_ROWS, STATE_FIELDS, StateFields
+from orbit_env.envs.state import ROW, SEGMENT_ROW, SEGMENT_ROWS, STATE_FIELDS, StateFields
 from orbit_env.envs.task import Task
 
 pytestmark = pytest.mark.skipif(kernel_module.compiled() is None, reason="needs numba (and ORBIT_ENV_JIT not 0)")
@@ -54,7 +54,7 @@ def _requests(task: Task, rng: np.random.Generator, n: int) -> np.ndarray:
 
 
 def test_every_state_row_is_its_fields() -> None:
-    """The rows the loops read (`state_layout.ROW`) are the rows `BatchState` keeps each field in."""
+    """The rows the loops read (`state.ROW`) are the rows `BatchState` keeps each field in."""
     assert STATE_FIELDS == StateFields._fields and len(set(ROW)) == len(STATE_FIELDS)
     state = task_model.start(TASKS["uncertain"], np.random.default_rng(2), 5)
     for name in STATE_FIELDS:

@@ -19,7 +19,8 @@ from orbit_env.agents.policies import Greedy
 from orbit_env.agents.shaping import outlook
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.task import BatchState, Task, TaskState
+from orbit_env.envs.state import STATE_FIELDS, BatchState, TaskState
+from orbit_env.envs.task import Task
 
 # Start orbits across the paper's range (km): near circular, elongated, low enough to re-enter in a
 # step (a 100 km burn cannot save it), and high enough that a 100 m/s burn meets the 4000 km cap.
@@ -48,7 +49,7 @@ def test_single_and_vector_env_take_the_same_step_from_pinned_states():
         obs_s, _ = single.reset(seed=0, options={"perigee_km": perigee, "apogee_km": apogee, "density_phase_rad": 0.0})
         np.testing.assert_allclose(obs_s, obs_v[i], rtol=ROUND_OFF)
         state_s = single.unwrapped.task_state
-        for name in task_model.STATE_FIELDS:
+        for name in STATE_FIELDS:
             assert getattr(state_s, name) == pytest.approx(getattr(before, name)[i], rel=ROUND_OFF, abs=1e-300)
         obs_s2, reward_s, terminated_s, _, info_s = single.step(int(action))
         assert info_s["burn_m_s"] == pytest.approx(info_v["burn_m_s"][i], rel=ROUND_OFF)

@@ -11,7 +11,7 @@ The formulas are `orbit_env.envs.task`'s, in the same order, on the same state a
 the same tables of the universal curves (`orbit_env.decay.curves`).
 
 The contract with the task model is declared once: the state's rows are
-`orbit_env.envs.state_layout.ROW`, the task's numbers `KernelParameters`, a table's scales
+`orbit_env.envs.state.ROW`, the task's numbers `KernelParameters`, a table's scales
 `orbit_env.decay.curves.GridScales`, and where a point falls on a table is
 `orbit_env.decay.curves.grid_cell`, the same function the single environment calls.
 
@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, E_FLOOR, NU_REF, GridScales, UniversalCurves, grid_cell
-from orbit_env.envs.state_layout import ROW, SEGMENT_ROW
+from orbit_env.envs.state import ROW, SEGMENT_ROW
 
 FloatArray = NDArray[np.float64]
 

@@ -20,6 +20,11 @@ state of arrays of shape (num_envs,), and the DP, the hand-coded policies and th
 reward shaping in `orbit_env.agents` on arrays of planned or decoded states.
 Nothing else composes burn, coast and reward.
 
+Its parts live by concern beside it: the state's fields and storage in `orbit_env.envs.state`,
+the rocket equation and the burn in `orbit_env.envs.rocket`, the reset options' checks in
+`orbit_env.envs.reset_options`, the continuous action space in `orbit_env.envs.spaces`, and
+the compiled step of a batch in `orbit_env.envs.kernel`.
+
 The dynamics are the paper's universal curves (`orbit_env.decay.curves`): K
 revolutions move the universal variable nu by K g c s (Eq. 4.1), and the time is the
 drop of W = Int P dnu over g c s. A perigee burn keeps the perigee and raises the
@@ -39,7 +44,6 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.checks import check_array
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
 from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
@@ -54,15 +58,11 @@ from orbit_env.envs.config import (
     MAX_DV_CAPACITY_M_S,
     DensityConfig,
     OrbitRaisingConfig,
-    validate_satellite,
 )
-from orbit_env.envs.state_layout import SEGMENT_ROW, SEGMENT_ROWS, STATE_FIELDS
-from orbit_env.physics.orbit import (
-    apogee_after_perigee_burn_m,
-    elements_from_heights,
-    perigee_velocity_m_s,
-    period_s,
-)
+from orbit_env.envs.reset_options import resolve_options
+from orbit_env.envs.rocket import delta_v_left_m_s, mass_from_delta_v_left_kg, perigee_burn
+from orbit_env.envs.spaces import UniformBox
+from orbit_env.envs.state import STALE_SEGMENT, AnyState, BatchState, TaskState
 
 FloatArray = NDArray[np.float64]
 
@@ -99,39 +99,7 @@ OBS_INDEX = {name: i for i, name in enumerate(OBS_NAMES)}
 OBS_LOW = np.zeros(len(OBS_NAMES), dtype=np.float32)
 OBS_HIGH = np.array([1.2, 5.0, MAX_DV_CAPACITY_M_S / DV_SCALE_M_S, 1.0, 1.0, 1.0, 1.0], dtype=np.float32)
 
-#: Reset options that pin the satellite (names of `OrbitRaisingConfig` fields).
-SATELLITE_OPTIONS = ("drag_coefficient", "area_m2", "dry_mass_kg", "propellant_mass_kg", "isp_s")
-#: Reset options that pin the orbit and the atmosphere.
-ORBIT_OPTIONS = ("perigee_km", "apogee_km", "density_scale", "density_phase_rad")
-RESET_OPTIONS = ORBIT_OPTIONS + SATELLITE_OPTIONS
-
 _UNSIGNED = {1: np.uint8, 2: np.uint16, 4: np.uint32, 8: np.uint64}  # by item size: the actions' range check
-
-
-class UniformBox(spaces.Box):
-    """A float `gymnasium.spaces.Box` bounded on every side, whose ``sample`` is one uniform draw.
-
-    Gymnasium's ``Box.sample`` sorts the coordinates into bounded, half-bounded and
-    unbounded ones with a dozen numpy calls (about 20 us, three CartPole steps). For a
-    float box bounded on every side that comes down to one uniform draw, made here
-    directly: the same numbers from the same generator (``tests/test_fast_paths.py``
-    compares them with ``Box.sample``'s). Bounds equal on every coordinate are
-    passed as two floats, with which numpy's ``uniform`` is five times faster
-    than with arrays.
-    """
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        assert self.is_bounded("both") and self.dtype.kind == "f", "a float box bounded on every side"
-        low, high = np.unique(self.low), np.unique(self.high)
-        self._bounds = (float(low[0]), float(high[0])) if low.size == high.size == 1 else (self.low, self.high)
-
-    def sample(self, mask: None = None, probability: None = None) -> NDArray[Any]:
-        """A point drawn uniformly in the box (masks are Box's: unsupported)."""
-        if mask is not None or probability is not None:
-            return super().sample(mask, probability)
-        low, high = self._bounds
-        return self.np_random.uniform(low, high, self.shape).astype(self.dtype)
 
 
 @dataclass(frozen=True)
@@ -277,196 +245,6 @@ class TaskView:
         return self.task.continuous
 
 
-# ---------------------------------------------------------------------------------
-# The state: Python floats for one satellite, rows of one array for many.
-# ---------------------------------------------------------------------------------
-
-#: A cell index no orbit is in: the next coast makes the orbit's cell afresh.
-STALE_SEGMENT = -np.inf
-
-
-class TaskState:
-    """The state of one satellite: every field of `STATE_FIELDS` (`orbit_env.envs.state_layout`) a Python float.
-
-    The single environment steps one of these; the task functions read and assign
-    its attributes exactly as they do a `BatchState`'s.
-    """
-
-    # point: the CurvePoint of (label, tau, period_s, nu), kept by the task functions that move the
-    # orbit so that a step builds no second one. segments: the orbit's cell of the curves' table B,
-    # a list (UniversalCurves.locate_segments), as a batch keeps its rows' cells.
-    __slots__ = (*STATE_FIELDS, "point", "segments")
-
-    def copy(self) -> TaskState:
-        """An independent copy."""
-        other = TaskState()
-        for name in self.__slots__:
-            setattr(other, name, getattr(self, name))
-        other.segments = list(self.segments)  # renewed in place by a coast
-        return other
-
-
-class BatchState:
-    """The states of many satellites: the rows of one (fields + segments, n) float64 array.
-
-    Each field is a row view, and assigning a field writes into its row, so the task
-    functions' ``state.perigee_m = ...`` updates the array in place; copying whole
-    missions (an automatic reset, a subset that burns) is one column assignment.
-
-    Args:
-        data: The (len(STATE_FIELDS) + SEGMENT_ROWS, n) array to view, or the number
-            of satellites for a new array of zeros.
-    """
-
-    def __init__(self, data: FloatArray | int) -> None:
-        if isinstance(data, (int, np.integer)):
-            data = _staggered_rows(int(data))
-            data[SEGMENT_ROW] = STALE_SEGMENT
-        assert data.shape[0] == SEGMENT_ROW + SEGMENT_ROWS
-        views = self.__dict__
-        views.update(zip(STATE_FIELDS, data, strict=False))  # the rows as views, iterated in C
-        views["segments"] = data[SEGMENT_ROW:]
-        views["data"] = data
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        row = self.__dict__[name]
-        if value is not row:  # an augmented assignment (state.x += y) has already written the row
-            row[...] = value
-
-    def __getstate__(self) -> tuple[FloatArray]:
-        return (self.data,)  # the array once, not its row views (which would unpickle as copies)
-
-    def __setstate__(self, state: tuple[FloatArray]) -> None:
-        data = _staggered_rows(state[0].shape[1])  # pickle stores the rows without their padding
-        data[...] = state[0]
-        self.__init__(data)
-
-    @property
-    def size(self) -> int:
-        """Number of satellites."""
-        return int(self.data.shape[1])
-
-    def take(self, index: Any) -> BatchState:
-        """A copy of the satellites at ``index`` (an index array or a boolean mask)."""
-        if isinstance(index, np.ndarray) and index.dtype == np.bool_:
-            index = np.flatnonzero(index)
-        return BatchState(self.data.take(index, axis=1))
-
-    def put(self, index: Any, other: BatchState | FloatArray) -> None:
-        """Write ``other``'s satellites (a `BatchState` or its data) into the places ``index``.
-
-        ``index``: positions (non-negative), a slice or a boolean mask, as numpy takes them.
-        """
-        values = other.data if isinstance(other, BatchState) else other
-        data = self.data
-        size = data.itemsize
-        if isinstance(index, np.ndarray) and index.ndim == 1 and index.dtype.kind == "i" and data.strides[1] == size:
-            # One scatter into the rows as one flat run (their padding included, `_staggered_rows`):
-            # a third of the time of data[:, index] = values.
-            rows, n = data.shape
-            row_stride = data.strides[0] // size
-            flat = np.lib.stride_tricks.as_strided(data, shape=((rows - 1) * row_stride + n,), strides=(size,))
-            flat[(np.arange(0, rows * row_stride, row_stride)[:, None] + index).ravel()] = values.ravel()
-        else:
-            data[:, index] = values
-
-    def copy(self) -> BatchState:
-        """An independent copy (rows staggered as a new batch's)."""
-        data = _staggered_rows(self.size)
-        data[...] = self.data
-        return BatchState(data)
-
-
-def _staggered_rows(n: int) -> FloatArray:
-    """A (fields + segments, n) array of zeros whose rows begin in different sets of the L1 cache.
-
-    Rows of a power-of-two length (4096 satellites: 32 KiB) begin a multiple of 4 KiB
-    apart, so every row of a column falls in the same set of the 8-way L1 cache, and a
-    loop over the satellites that reads and writes some 30 rows evicts its own lines at
-    every satellite: the compiled coast of 4096 satellites took 226 us against 41 us
-    for 4104 (measured on the 2-core AMD EPYC machine, 2026-12-03). Each row here is a
-    view into a wider array whose row length is an odd number of 64-byte lines, which
-    spreads consecutive rows over distinct sets.
-    """
-    rows = SEGMENT_ROW + SEGMENT_ROWS
-    line = 64 // np.dtype(np.float64).itemsize
-    width = -(-n // line) * line
-    if (width // line) % 2 == 0:
-        width += line
-    return np.zeros((rows, width))[:, :n]
-
-
-AnyState = TaskState | BatchState
-
-
-# ---------------------------------------------------------------------------------
-# Physics of the task: the burn and the rocket equation.
-# ---------------------------------------------------------------------------------
-
-
-def delta_v_left_m_s(mass_kg: ArrayLike, dry_mass_kg: ArrayLike, exhaust_velocity_m_s: ArrayLike) -> FloatArray:
-    """Delta-v the propellant on board still gives, Tsiolkovsky: v_e ln(m / m_dry) [m/s]."""
-    if isinstance(mass_kg, float) and isinstance(dry_mass_kg, float) and isinstance(exhaust_velocity_m_s, float):
-        return exhaust_velocity_m_s * math.log(mass_kg / dry_mass_kg)  # one satellite: no numpy on floats
-    return exhaust_velocity_m_s * np.log(np.divide(mass_kg, dry_mass_kg))
-
-
-def mass_from_delta_v_left_kg(dv_left_m_s: ArrayLike, dry_mass_kg: ArrayLike, exhaust_velocity_m_s: ArrayLike) -> Any:
-    """The mass that still gives ``dv_left_m_s`` of delta-v, by the rocket equation [kg]."""
-    return dry_mass_kg * np.exp(np.divide(dv_left_m_s, exhaust_velocity_m_s))
-
-
-def perigee_burn(
-    perigee_m: ArrayLike,
-    apogee_m: ArrayLike,
-    mass_kg: ArrayLike,
-    dry_mass_kg: ArrayLike,
-    exhaust_velocity_m_s: ArrayLike,
-    requested_dv_m_s: ArrayLike,
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Fire the engine at perigee: the burn actually made, the new apogee and the new mass.
-
-    The burn is the request cut to the propellant on board (rocket equation) and to
-    the burn that takes the apogee to the top of the universal curves,
-    ``CURVES_MAX_APOGEE_M`` (4000 km); the perigee does not change.
-
-    Returns:
-        (dv [m/s], apogee after the burn [m], mass after the burn [kg]).
-    """
-    dv_fuel = delta_v_left_m_s(mass_kg, dry_mass_kg, exhaust_velocity_m_s)
-    dv = np.maximum(np.minimum(requested_dv_m_s, dv_fuel), 0.0)
-    apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
-    # Beyond the cap (escape included: its apogee is unbounded): burn only up to the cap.
-    # Rare, so the cap's burn is computed only when some burn needs it.
-    over = apogee_after > CURVES_MAX_APOGEE_M
-    if over.any():
-        dv_cap = perigee_velocity_m_s(perigee_m, CURVES_MAX_APOGEE_M) - perigee_velocity_m_s(perigee_m, apogee_m)
-        dv = np.where(over, np.maximum(np.minimum(dv, dv_cap), 0.0), dv)
-        apogee_after = apogee_after_perigee_burn_m(perigee_m, apogee_m, dv)
-    apogee_after = np.minimum(apogee_after, CURVES_MAX_APOGEE_M)
-    mass_after = mass_kg / np.exp(dv / exhaust_velocity_m_s)
-    # Emptying the tank leaves exactly the dry mass (the exponential rounds either way).
-    mass_after = np.where(dv >= dv_fuel, dry_mass_kg, np.maximum(mass_after, dry_mass_kg))
-    return dv, apogee_after, mass_after
-
-
-def period_gain_days_per_m_s_per_step(revolutions_per_step: float) -> float:
-    """The most days a step of K revolutions can gain per m/s of perigee burn, by the longer period alone.
-
-    K times the largest dP/d(dv) of a perigee burn over the curves' domain, per day.
-    P grows convexly with the perigee speed and fastest at the highest apogee, so
-    the rate is taken at the 4000 km cap, for perigees 100-1100 km, by a 1 mm/s
-    difference. A bound on what a burn buys a satellite that outlives the mission
-    anyway (the DP's coasting stages, the training's decided episodes).
-    """
-    perigee_m = np.linspace(REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M, 101)
-    step_m_s = 1e-3
-    p, e = elements_from_heights(perigee_m, CURVES_MAX_APOGEE_M)
-    p2, e2 = elements_from_heights(perigee_m, apogee_after_perigee_burn_m(perigee_m, CURVES_MAX_APOGEE_M, step_m_s))
-    rate_s_per_m_s = float(np.max(period_s(p2, e2) - period_s(p, e)) / step_m_s)
-    return revolutions_per_step * rate_s_per_m_s / SECONDS_PER_DAY
-
-
 def density_scale_at(
     base_scale: ArrayLike, amplitude: float, period_days: float, phase_rad: ArrayLike, time_days: ArrayLike
 ) -> FloatArray:
@@ -530,61 +308,6 @@ def sample_start(
     return {"perigee_km": perigee_km, "apogee_km": apogee_km, "density_scale": scale, "density_phase_rad": phase}
 
 
-def resolve_options(
-    options: Mapping[str, Any] | None, drawn: dict[str, Any], config: OrbitRaisingConfig, size: int | None = None
-) -> dict[str, Any]:
-    """Merge reset options over the drawn start and the config's satellite, and validate.
-
-    Options may be scalars or, for the vector environment, arrays of shape (num_envs,).
-
-    Raises:
-        ValueError: an unknown option, or a value out of range (named, with the range).
-    """
-    options = dict(options or {})
-    unknown = sorted(set(options) - set(RESET_OPTIONS))
-    if unknown:
-        raise ValueError(f"unknown reset option(s) {unknown}; allowed: {list(RESET_OPTIONS)}")
-    merged: dict[str, Any] = {name: getattr(config, name) for name in SATELLITE_OPTIONS}
-    merged.update(drawn)
-    if not options:
-        # The config's satellite and draws from its ranges, both checked when the config was made:
-        # every automatic reset, where the checks would cost ten times the rest.
-        return merged
-    shape = () if size is None else (size,)
-    for name, value in options.items():
-        array = np.asarray(value, dtype=np.float64) if not isinstance(value, (str, bytes)) else None
-        if array is None or (array.shape != () and array.shape != shape):
-            raise ValueError(f"reset option {name}={value!r} must be a number or an array of shape {shape}")
-        if not np.all(np.isfinite(array)):
-            raise ValueError(f"reset option {name}={value!r} must be finite")
-        merged[name] = float(array) if array.shape == () else array.copy()  # a number pins every satellite
-    if "perigee_km" in options and "apogee_km" not in options:
-        # A pinned perigee above the drawn apogee makes the drawn orbit circular.
-        merged["apogee_km"] = np.maximum(merged["apogee_km"], merged["perigee_km"])
-    if "apogee_km" in options and "perigee_km" not in options:
-        merged["perigee_km"] = np.minimum(merged["perigee_km"], merged["apogee_km"])
-    if size is None:
-        merged["perigee_km"], merged["apogee_km"] = float(merged["perigee_km"]), float(merged["apogee_km"])
-    validate_satellite(**{name: merged[name] for name in SATELLITE_OPTIONS})
-    domain = "the universal curves' domain"
-    # Checked together: a pinned apogee's bound is each satellite's perigee, drawn or pinned.
-    perigee_km, apogee_km = np.broadcast_arrays(merged["perigee_km"], merged["apogee_km"])
-    check_array(
-        perigee_km, "perigee_km", unit="km", low=REENTRY_ALTITUDE_M / 1e3, high=CURVES_MAX_PERIGEE_M / 1e3, why=domain
-    )
-    check_array(
-        apogee_km,
-        "apogee_km",
-        unit="km",
-        low=perigee_km,
-        low_name="perigee_km",
-        high=CURVES_MAX_APOGEE_M / 1e3,
-        why=domain,
-    )
-    check_array(merged["density_scale"], "density_scale", low=0.0, low_inclusive=False)
-    return merged
-
-
 def _new_state(size: int | None) -> AnyState:
     return TaskState() if size is None else BatchState(size)
 
@@ -599,7 +322,7 @@ def start(
         rng: The generator to draw from (the env's ``np_random``).
         size: None for one satellite (a `TaskState` of floats), else the
             number of satellites (a `BatchState`).
-        options: Reset options (`RESET_OPTIONS`), numbers or arrays of shape (size,).
+        options: Reset options (`orbit_env.envs.reset_options.RESET_OPTIONS`), numbers or arrays of shape (size,).
 
     Raises:
         ValueError: an unknown or invalid option.

@@ -30,7 +30,8 @@ from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig, resolve_task_arguments
-from orbit_env.envs.task import BatchState, Task, TaskView
+from orbit_env.envs.state import BatchState
+from orbit_env.envs.task import Task, TaskView
 
 FloatArray = NDArray[np.float64]
 
