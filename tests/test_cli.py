@@ -188,6 +188,7 @@ _LAW = ["--rho0", "1.3", "--h0-km", "0"]
             "(the models are off by a factor of a few at most; 1000 is another atmosphere)",
         ),
         ([*_ORBIT, "--rule", "0"], "--rule 0 is out of range; allowed: above 0 years"),
+        ([*_ORBIT, "--msis-version", "00", "--atmosphere", "paper"], "--msis-version applies to --atmosphere msis"),
     ],
 )
 def test_bad_values_name_the_flag_and_the_value_as_typed(capsys, argv, message):
@@ -275,3 +276,52 @@ def test_satellite_validation():
         make_satellite(2.0, 10.0, 1.0, 50.0)
     # Section 4: for the paper's sphere, 4G / (pi d^2) / (g c_x) is about 2.6.
     assert Satellite().revolutions_per_nu == pytest.approx(2.6, abs=0.01)
+
+
+def _lifetime_line_days(text):
+    """The days of the text summary's lifetime line."""
+    line = next(line for line in text.splitlines() if line.startswith("lifetime "))
+    return float(line.split()[1])
+
+
+def test_msis_version_00_is_nrlmsise00_and_shortens_the_life(capsys):
+    pytest.importorskip("pymsis")
+    orbit = ["lifetime", "--perigee", "400", "--apogee", "420", "--atmosphere", "msis", "--inclination", "51.6"]
+    _, out, _ = run(capsys, *orbit, "--json")
+    default = json.loads(out)
+    status, out, _ = run(capsys, *orbit, "--msis-version", "00", "--json")
+    v00 = json.loads(out)
+    assert status == 0
+    assert default["atmosphere"].startswith("NRLMSIS 2.1, ") and v00["atmosphere"].startswith("NRLMSISE-00, ")
+    # The life goes about as 1/density, and NRLMSISE-00 is 8-19% denser (tests/test_msis.py): 0.84-0.93,
+    # with margin for the profile's shape.
+    assert 0.80 < v00["days"] / default["days"] < 0.95
+    _, out, _ = run(capsys, *orbit, "--msis-version", "2.1", "--json")
+    assert json.loads(out) == default  # 2.1 given is the default
+
+
+def test_msis_version_on_a_dated_life_and_in_the_text(capsys):
+    pytest.importorskip("pymsis")
+    orbit = ["lifetime", "--perigee", "300", "--apogee", "320", "--epoch", "2003-10-01", "--inclination", "28.5"]
+    orbit += ["--mass", "4", "--area", "0.03", "--cx", "2.2"]
+    _, default, _ = run(capsys, *orbit)
+    status, v00, _ = run(capsys, *orbit, "--msis-version", "00")
+    assert status == 0
+    assert "atmosphere         NRLMSIS 2.1, " in default and "atmosphere         NRLMSISE-00, " in v00
+    # The time-stepped path (bins and day ratios) in NRLMSISE-00: shorter, by about the density ratio.
+    assert 0.80 < _lifetime_line_days(v00) / _lifetime_line_days(default) < 0.95
+
+
+def test_fit_density_takes_the_msis_version(capsys, tmp_path):
+    pytest.importorskip("pymsis")
+    observations = tmp_path / "obs.csv"
+    observations.write_text("days,perigee_km,apogee_km\n0,400,420\n")
+    argv = ["fit-density", str(observations), "--reentry", "200", "--atmosphere", "msis", "--inclination", "51.6"]
+    argv += ["--mass", "4", "--area", "0.03", "--cx", "2.2", "--json"]
+    _, out, _ = run(capsys, *argv)
+    default = json.loads(out)
+    status, out, _ = run(capsys, *argv, "--msis-version", "00")
+    v00 = json.loads(out)
+    assert status == 0 and v00["atmosphere"].startswith("NRLMSISE-00, ")
+    # The same decay in denser air takes a smaller scale: by the density ratio, 1/1.19 to 1/1.08.
+    assert 0.80 < v00["scale"] / default["scale"] < 0.95

@@ -15,6 +15,7 @@ import time
 from typing import Any
 
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
+from orbit_env.analysis.air.msis import MSIS_VERSION_CHOICES
 from orbit_env.analysis.lifetime import (
     METHODS,
     PAPER_DRAG_COEFFICIENT,
@@ -316,6 +317,11 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--cycle-phase", type=number, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
     group.add_argument(
         "--epoch", metavar="DATE", help="msis: the orbit's date: follow the season and the activity from then on"
+    )
+    group.add_argument(
+        "--msis-version",
+        choices=tuple(MSIS_VERSION_CHOICES),
+        help="msis: NRLMSIS version (default 2.1; 00 = NRLMSISE-00)",
     )
     group.add_argument("--node-local-time", type=number, metavar="HOURS", help="msis: Sun-synchronous node local time")
     group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")

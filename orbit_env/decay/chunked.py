@@ -42,9 +42,11 @@ from orbit_env.decay.solar import SolarActivity, day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
+    DEFAULT_MSIS_VERSION,
     SEASON_NODES,
     MsisAtmosphere,
     _msis_density,
+    check_msis_version,
     interpolate_log_density,
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
@@ -123,12 +125,21 @@ def _log_ratio(
     binned: tuple[float, float],
     inclination_deg: float,
     ascending_node_local_time_h: float | None,
+    version: float,
 ) -> FloatArray:
     f107, f107a, ap, doy = (np.array(column) for column in zip(*daily, strict=True))
     rho_exact = mean_density_over_days_kg_m3(
-        RATIO_GRID_M, f107, f107a, ap, doy, inclination_deg, ascending_node_local_time_h, **RATIO_NODES
+        RATIO_GRID_M,
+        f107,
+        f107a,
+        ap,
+        doy,
+        inclination_deg,
+        ascending_node_local_time_h,
+        **RATIO_NODES,
+        version=version,
     )
-    return np.log(rho_exact) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h)
+    return np.log(rho_exact) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h, version)
 
 
 @lru_cache(maxsize=1024)
@@ -138,21 +149,31 @@ def _log_ratios_by_day(
     binned: tuple[float, float],
     inclination_deg: float,
     ascending_node_local_time_h: float | None,
+    version: float,
 ) -> FloatArray:
     """`_log_ratio` of each day of ``daily`` (``per_day`` rows each), in one NRLMSIS call: shape (days, heights)."""
     f107, f107a, ap, doy = (np.array(column) for column in zip(*daily, strict=True))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, **RATIO_NODES)
-    rho = _msis_density(RATIO_GRID_M, lat[None, :], local_time[None, :], doy - 1.0, f107, f107a, ap)[0]
+    rho = _msis_density(RATIO_GRID_M, lat[None, :], local_time[None, :], doy - 1.0, f107, f107a, ap, version)[0]
     rho_days = rho.reshape(-1, per_day, *rho.shape[1:]).mean(axis=(1, 2))
-    return np.log(rho_days) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h)[None, :]
+    bin_log_rho = _log_bin_density(binned, inclination_deg, ascending_node_local_time_h, version)
+    return np.log(rho_days) - bin_log_rho[None, :]
 
 
 @lru_cache(maxsize=256)
 def _log_bin_density(
-    binned: tuple[float, float], inclination_deg: float, ascending_node_local_time_h: float | None
+    binned: tuple[float, float], inclination_deg: float, ascending_node_local_time_h: float | None, version: float
 ) -> FloatArray:
     rho = mean_density_kg_m3(
-        RATIO_GRID_M, binned[0], binned[0], binned[1], inclination_deg, None, ascending_node_local_time_h, **RATIO_NODES
+        RATIO_GRID_M,
+        binned[0],
+        binned[0],
+        binned[1],
+        inclination_deg,
+        None,
+        ascending_node_local_time_h,
+        **RATIO_NODES,
+        version=version,
     )
     return np.log(rho)
 
@@ -321,6 +342,8 @@ class SolarDecayModel:
         chunk_days: Length of a time step.
         bin_step: Bin width in ln(81-day mean F10.7).
         max_years: Stop propagating after this long.
+        version: NRLMSIS version of every profile and ratio (see
+            `orbit_env.physics.atmosphere.msis.MSIS_VERSIONS`; 0.0 is NRLMSISE-00).
     """
 
     activity: SolarActivity
@@ -332,6 +355,7 @@ class SolarDecayModel:
     chunk_days: float = DEFAULT_CHUNK_DAYS
     bin_step: float = DEFAULT_BIN_STEP
     max_years: float = DEFAULT_MAX_YEARS
+    version: float = DEFAULT_MSIS_VERSION
     _bins: dict[tuple[float, float], DecayModel] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -339,6 +363,7 @@ class SolarDecayModel:
         check_number(self.bin_step, "bin_step", low=0.0, high=1.0, low_inclusive=False)
         check_number(self.max_years, "max_years", unit="years", low=0.0, high=1000.0, low_inclusive=False)
         check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
+        object.__setattr__(self, "version", check_msis_version(self.version))
 
     def chunk_condition(self, t_days: float) -> tuple[DailyIndices, tuple[float, float]]:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""
@@ -383,7 +408,12 @@ class SolarDecayModel:
         days = self.start_days + first_day + np.arange(count, dtype=np.float64)
         per_day = 1 if self.follow_season else SEASON_NODES
         return _log_ratios_by_day(
-            self.daily_indices(days), per_day, binned, float(self.inclination_deg), self.ascending_node_local_time_h
+            self.daily_indices(days),
+            per_day,
+            binned,
+            float(self.inclination_deg),
+            self.ascending_node_local_time_h,
+            self.version,
         )
 
     @staticmethod
@@ -393,14 +423,20 @@ class SolarDecayModel:
 
     def log_ratio(self, daily: DailyIndices, binned: tuple[float, float]) -> FloatArray:
         """ln(the mean density over ``daily`` / the bin's) on `RATIO_GRID_M` (cached)."""
-        return _log_ratio(daily, binned, float(self.inclination_deg), self.ascending_node_local_time_h)
+        return _log_ratio(daily, binned, float(self.inclination_deg), self.ascending_node_local_time_h, self.version)
 
     def bin_model(self, binned: tuple[float, float]) -> DecayModel:
         """The decay model of a bin (its atmosphere: NRLMSIS at the binned indices, year-averaged)."""
         model = self._bins.get(binned)
         if model is None:
             atmosphere = MsisAtmosphere(
-                binned[0], binned[0], binned[1], self.inclination_deg, None, self.ascending_node_local_time_h
+                binned[0],
+                binned[0],
+                binned[1],
+                self.inclination_deg,
+                None,
+                self.ascending_node_local_time_h,
+                version=self.version,
             )
             model = DecayModel(atmosphere, self.rotating_atmosphere, self.inclination_deg)
             self._bins[binned] = model
@@ -487,7 +523,7 @@ class SolarDecayModel:
         middle = self.start_days + t_days + 0.5 * self.chunk_days
         doy = float(np.clip(2.0 * np.round(day_of_year(middle) / 2.0), 1.0, 366.0)) if self.follow_season else None
         log_rho = _anchor_log_density(
-            (f107, f107a, ap, doy), tuple(anchors_deg.tolist()), self.ascending_node_local_time_h
+            (f107, f107a, ap, doy), tuple(anchors_deg.tolist()), self.ascending_node_local_time_h, self.version
         )
         return np.asarray(basis @ log_rho, dtype=np.float64)
 
@@ -497,12 +533,21 @@ def _anchor_log_density(
     indices: tuple[float, float, float, float | None],
     anchors_deg: tuple[float, ...],
     ascending_node_local_time_h: float | None,
+    version: float,
 ) -> FloatArray:
     from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
 
     f107, f107a, ap, doy = indices
     rho = mean_density_over_inclinations_kg_m3(
-        RATIO_GRID_M, f107, f107a, ap, anchors_deg, ascending_node_local_time_h, day_of_year=doy, **RATIO_NODES
+        RATIO_GRID_M,
+        f107,
+        f107a,
+        ap,
+        anchors_deg,
+        ascending_node_local_time_h,
+        day_of_year=doy,
+        **RATIO_NODES,
+        version=version,
     )
     return np.log(rho)
 
@@ -910,7 +955,14 @@ def _solve_reference(
             f107, f107a, ap = (float(x) for x in model.activity.indices(model.start_days + t_days))
             doy = float(day_of_year(model.start_days + t_days)) if model.follow_season else None
             rho = mean_density_kg_m3(
-                ALTITUDE_GRID_M, f107, f107a, ap, model.inclination_deg, doy, model.ascending_node_local_time_h
+                ALTITUDE_GRID_M,
+                f107,
+                f107a,
+                ap,
+                model.inclination_deg,
+                doy,
+                model.ascending_node_local_time_h,
+                version=model.version,
             )
             profiles[index] = np.log(rho)
         return profiles[index]

@@ -1,4 +1,4 @@
-"""NRLMSIS 2.1 under constant, tabulated, cyclic or the real Sun's activity; dated when it has an epoch."""
+"""NRLMSIS (2.1, 2.0 or NRLMSISE-00) under constant, tabulated, cyclic or the real Sun's activity; dated by an epoch."""
 
 from __future__ import annotations
 
@@ -20,15 +20,22 @@ from orbit_env.decay.solar import (
     read_solar_csv,
     unix_days,
 )
-from orbit_env.physics.atmosphere.msis import MsisAtmosphere
+from orbit_env.physics.atmosphere.msis import (
+    DEFAULT_MSIS_VERSION,
+    MSIS_VERSION_NAMES,
+    MsisAtmosphere,
+    check_msis_version,
+)
 
 #: NRLMSIS's activity when none is given: F10.7 = 150 sfu (daily and 81-day mean), Ap = 15.
 DEFAULT_ACTIVITY = ConstantActivity(150.0, 150.0, 15.0)
+#: The versions as the command line writes them (``--msis-version``), and the version each is.
+MSIS_VERSION_CHOICES = {"2.1": 2.1, "2.0": 2.0, "00": 0.0}
 
 
 @dataclass(frozen=True)
 class MsisAir(Air):
-    """NRLMSIS 2.1, orbit-averaged (`orbit_env.physics.atmosphere.msis`).
+    """NRLMSIS, orbit-averaged (`orbit_env.physics.atmosphere.msis`).
 
     Args:
         activity: Indices against time (default: F10.7 = 150, Ap = 15, constant).
@@ -37,6 +44,8 @@ class MsisAir(Air):
         ascending_node_local_time_h: Sun-synchronous orbits: the node's local solar time.
         follow_season: The time-stepped path follows the season from the epoch (False: the
             season averaged, for an activity placed on a date that is not the orbit's).
+        version: NRLMSIS version: 2.1 (default), 2.0, or 0.0 for NRLMSISE-00 (to compare
+            with tools that run it: STK, Orekit).
     """
 
     name: ClassVar[str] = "msis"
@@ -51,14 +60,17 @@ class MsisAir(Air):
         "cycle_phase",
         "epoch",
         "node_local_time",
+        "msis_version",
     )
 
     activity: SolarActivity | None = None
     epoch_days: float | None = None
     ascending_node_local_time_h: float | None = None
     follow_season: bool = True
+    version: float = DEFAULT_MSIS_VERSION
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "version", check_msis_version(self.version))
         if self.epoch_days is None and self.activity is not None and not isinstance(self.activity, ConstantActivity):
             raise ValueError("activity that changes with time needs an epoch (a start date)")
 
@@ -74,9 +86,10 @@ class MsisAir(Air):
 
     @classmethod
     def from_options(cls, options: Mapping[str, Any]) -> MsisAir:
-        """``--epoch``, ``--solar-csv``, ``--solar-cycle``/``--cycle-phase``, ``--f107/--f107a/--ap``.
+        """``--epoch``, ``--solar-csv``, ``--solar-cycle``/``--cycle-phase``, ``--f107/--f107a/--ap``, the version.
 
         A date and no other solar option: the real Sun (the shipped or imported record).
+        ``msis_version`` is a key of `MSIS_VERSION_CHOICES` (None: 2.1).
         """
         text = options.get("epoch")
         epoch = None if text is None else check_date(unix_days(text), "--epoch", text=text)
@@ -104,7 +117,11 @@ class MsisAir(Air):
         else:
             f107 = 150.0 if f107 is None else f107
             activity = ConstantActivity(f107, f107 if f107a is None else f107a, 15.0 if ap is None else ap)
-        return cls(activity, epoch, options.get("node_local_time"))
+        text_version = options.get("msis_version")
+        if text_version is not None and text_version not in MSIS_VERSION_CHOICES:
+            raise ValueError(f"--msis-version must be one of {', '.join(MSIS_VERSION_CHOICES)}, got {text_version!r}")
+        version = DEFAULT_MSIS_VERSION if text_version is None else MSIS_VERSION_CHOICES[text_version]
+        return cls(activity, epoch, options.get("node_local_time"), version=version)
 
     def profile(self, inclination_deg: float, scale: float = 1.0) -> MsisAtmosphere:
         """The profile of constant activity, averaged over the year (an air without a date)."""
@@ -113,7 +130,14 @@ class MsisAir(Air):
         solar = self.solar
         assert isinstance(solar, ConstantActivity)
         return MsisAtmosphere(
-            solar.f107_sfu, solar.f107a_sfu, solar.ap, inclination_deg, None, self.ascending_node_local_time_h, scale
+            solar.f107_sfu,
+            solar.f107a_sfu,
+            solar.ap,
+            inclination_deg,
+            None,
+            self.ascending_node_local_time_h,
+            scale,
+            self.version,
         )
 
     def curves(self, model: DecayModel) -> UniversalCurves:
@@ -134,6 +158,7 @@ class MsisAir(Air):
             inclination_deg,
             follow_season=self.follow_season,
             ascending_node_local_time_h=self.ascending_node_local_time_h,
+            version=self.version,
             **settings,
         )
 
@@ -155,6 +180,7 @@ class MsisAir(Air):
             inclinations_deg,
             self.ascending_node_local_time_h,
             **nodes,
+            version=self.version,
         )
 
     def describe(self, inclination_deg: float, details: str = "") -> str:
@@ -176,4 +202,4 @@ class MsisAir(Air):
         where = f"inclination {inclination_deg:g} deg"
         if self.ascending_node_local_time_h is not None:
             where += f", node at {self.ascending_node_local_time_h:g} h local time"
-        return f"NRLMSIS 2.1, {what}, {where}{details}"
+        return f"{MSIS_VERSION_NAMES[self.version]}, {what}, {where}{details}"

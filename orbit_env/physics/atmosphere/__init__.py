@@ -4,7 +4,7 @@
   `as_atmosphere` (a user's function of altitude).
 * `paper`: the paper's law, Eq. (1.1) with Table 1.
 * `exponential`: an isothermal exponential law.
-* `msis`: NRLMSIS 2.1 through ``pymsis``, orbit-averaged
+* `msis`: NRLMSIS (2.1, 2.0 or NRLMSISE-00) through ``pymsis``, orbit-averaged
   (imported on use: it needs the ``msis`` extra).
 """
 

@@ -1,4 +1,4 @@
-"""NRLMSIS 2.1 (through ``pymsis``) as an orbit-averaged density profile, SI units.
+"""NRLMSIS (through ``pymsis``) as an orbit-averaged density profile, SI units.
 
 The decay core needs density against altitude only (``density_kg_m3(altitude_m)``,
 altitude above the package's spherical Earth of radius ``EARTH_RADIUS_M``). NRLMSIS
@@ -51,6 +51,11 @@ and extrapolated above the grid with its top slope. Building a table costs about
 0.3 s (~600 000 NRLMSIS points) and is cached per condition, so the universal
 curves of `orbit_env.decay.curves` can be built and cached per profile too.
 
+Versions (``version``, `MSIS_VERSIONS`): 2.1 (the default, Emmert et al. 2022), 2.0 and 0.0
+for NRLMSISE-00 (Picone et al. 2002), the version most numerical propagators (STK, Orekit)
+run: 8-19% denser than 2.1 at the heights that decide a lifetime (docs/how-to/lifetime.md).
+Every table is cached per version.
+
 Nothing is downloaded: all indices are given explicitly to ``pymsis``.
 """
 
@@ -84,6 +89,12 @@ SEASON_NODES = 6
 #: Allowed ranges of the indices (NRLMSIS is fitted to F10.7 of about 60-300 sfu).
 F107_RANGE_SFU = (40.0, 400.0)
 AP_RANGE = (0.0, 400.0)
+#: NRLMSIS versions ``pymsis`` runs: 2.1, 2.0 and 0.0 (NRLMSISE-00).
+MSIS_VERSIONS = (2.1, 2.0, 0.0)
+#: The version used unless one is chosen.
+DEFAULT_MSIS_VERSION = 2.1
+#: Each version's name.
+MSIS_VERSION_NAMES = {2.1: "NRLMSIS 2.1", 2.0: "NRLMSIS 2.0", 0.0: "NRLMSISE-00"}
 
 #: Altitude grid of the tables [m]: fine where the scale height is short.
 ALTITUDE_GRID_M = np.concatenate(
@@ -107,6 +118,23 @@ def require_pymsis() -> Any:
     except ImportError as error:  # pragma: no cover - exercised only without pymsis
         raise ImportError(MSIS_INSTALL_HINT) from error
     return msis
+
+
+def check_msis_version(version: float) -> float:
+    """``version`` as a float, if it is one of `MSIS_VERSIONS`.
+
+    Raises:
+        ValueError: another value, naming the allowed ones.
+    """
+    if isinstance(version, bool) or not isinstance(version, (int, float)) or version not in MSIS_VERSIONS:
+        allowed = ", ".join(f"{v:g}" for v in MSIS_VERSIONS)
+        raise ValueError(f"NRLMSIS version must be one of {allowed} (0 = NRLMSISE-00), got {version!r}")
+    return float(version)
+
+
+def _pymsis_version(version: float) -> float | str:
+    """``pymsis``'s name of a version: it reads ``str(version)``, and knows "0" but not "0.0"."""
+    return "0" if version == 0.0 else version
 
 
 def orbit_samples(
@@ -156,8 +184,9 @@ def mean_density_kg_m3(
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
     season_nodes: int = SEASON_NODES,
+    version: float = DEFAULT_MSIS_VERSION,
 ) -> FloatArray:
-    """NRLMSIS 2.1 density [kg/m^3] averaged over an orbit's latitudes, local times and season.
+    """NRLMSIS density [kg/m^3] (``version``) averaged over an orbit's latitudes, local times and season.
 
     The averaging is described in the module docstring. ``altitude_m`` is a 1-D
     array of heights above the package's spherical Earth.
@@ -177,6 +206,7 @@ def mean_density_kg_m3(
         ascending_node_local_time_h,
         latitude_nodes=latitude_nodes,
         local_time_nodes=local_time_nodes,
+        version=version,
     )
 
 
@@ -188,11 +218,12 @@ def _msis_density(
     f107_sfu: ArrayLike,
     f107a_sfu: ArrayLike,
     ap: ArrayLike,
+    version: float = DEFAULT_MSIS_VERSION,
 ) -> FloatArray:
-    """NRLMSIS 2.1 mass density [kg/m^3] on a grid, in one call: shape (groups, days, samples, altitudes).
+    """NRLMSIS mass density [kg/m^3] on a grid, in one call: shape (groups, days, samples, altitudes).
 
     ``lat`` and ``local_time`` are (groups, samples) orbit samples; ``days`` are days of
-    the year from 0; the indices are per day (or scalars).
+    the year from 0; the indices are per day (or scalars); ``version`` one of `MSIS_VERSIONS`.
     """
     msis = require_pymsis()
     lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
@@ -216,7 +247,7 @@ def _msis_density(
         f107s=per_point(f107_sfu),
         f107as=per_point(f107a_sfu),
         aps=np.repeat(per_point(ap)[:, None], 7, axis=1),
-        version=2.1,
+        version=_pymsis_version(check_msis_version(version)),
     )
     return np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
 
@@ -232,8 +263,9 @@ def mean_density_over_days_kg_m3(
     *,
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
+    version: float = DEFAULT_MSIS_VERSION,
 ) -> FloatArray:
-    """Orbit-averaged NRLMSIS 2.1 density [kg/m^3], averaged again over days with their own indices.
+    """Orbit-averaged NRLMSIS density [kg/m^3] (``version``), averaged again over days with their own indices.
 
     The k-th day has indices ``f107_sfu[k]``, ``f107a_sfu[k]``, ``ap[k]`` and day of
     the year ``day_of_year[k]`` (1-366). One NRLMSIS call for all of them. The mean
@@ -243,7 +275,7 @@ def mean_density_over_days_kg_m3(
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
     days = np.atleast_1d(np.asarray(day_of_year, dtype=np.float64)) - 1.0
-    rho = _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap)
+    rho = _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap, version)
     return rho[0].mean(axis=(0, 1))
 
 
@@ -259,6 +291,7 @@ def mean_density_over_inclinations_kg_m3(
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
     season_nodes: int = SEASON_NODES,
+    version: float = DEFAULT_MSIS_VERSION,
 ) -> FloatArray:
     """`mean_density_kg_m3` (averaged over the year, or on ``day_of_year``) at several inclinations, in one call.
 
@@ -278,12 +311,16 @@ def mean_density_over_inclinations_kg_m3(
         days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes
     else:
         days = np.array([float(day_of_year) - 1.0])
-    return _msis_density(alt, lat, local_time, days, f107_sfu, f107a_sfu, ap).mean(axis=(1, 2))
+    return _msis_density(alt, lat, local_time, days, f107_sfu, f107a_sfu, ap, version).mean(axis=(1, 2))
 
 
 @lru_cache(maxsize=256)
 def _cached_log_density_table(*conditions: float | None) -> FloatArray:
-    """`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls."""
+    """`_log_density_table`, kept on disk (orbit_env.cache): a profile costs NRLMSIS thousands of calls.
+
+    ``conditions`` are `_log_density_table`'s arguments, the version last: every key, in memory
+    and on disk, names the version.
+    """
     description = cache.describe(conditions)
     table = cache.load("msis", description)
     if table is None:
@@ -299,9 +336,17 @@ def _log_density_table(
     inclination_deg: float,
     day_of_year: float | None,
     ascending_node_local_time_h: float | None,
+    version: float,
 ) -> FloatArray:
     rho = mean_density_kg_m3(
-        ALTITUDE_GRID_M, f107_sfu, f107a_sfu, ap, inclination_deg, day_of_year, ascending_node_local_time_h
+        ALTITUDE_GRID_M,
+        f107_sfu,
+        f107a_sfu,
+        ap,
+        inclination_deg,
+        day_of_year,
+        ascending_node_local_time_h,
+        version=version,
     )
     assert np.all(np.isfinite(rho) & (rho > 0.0)), "NRLMSIS returned a non-positive density"
     return np.log(rho)
@@ -318,7 +363,7 @@ def interpolate_log_density(altitude_m: ArrayLike, log_rho: FloatArray) -> Float
 
 @dataclass(frozen=True)
 class MsisAtmosphere:
-    """NRLMSIS 2.1 averaged over an orbit, at fixed solar and geomagnetic activity.
+    """NRLMSIS averaged over an orbit, at fixed solar and geomagnetic activity.
 
     Frozen and hashable: `orbit_env.decay.curves.universal_curves` caches the
     curves per instance, and the density table is cached per condition.
@@ -332,6 +377,8 @@ class MsisAtmosphere:
         ascending_node_local_time_h: Local solar time of the ascending node of a
             Sun-synchronous orbit [h]; None (default) averages over local time.
         scale: Multiplier on the whole profile.
+        version: NRLMSIS version, one of `MSIS_VERSIONS`: 2.1 (default), 2.0, or 0.0
+            for NRLMSISE-00 (what STK and Orekit users mostly run).
 
     Examples:
         >>> atmosphere = MsisAtmosphere(150.0, 150.0, 15.0, inclination_deg=51.6)
@@ -346,6 +393,7 @@ class MsisAtmosphere:
     day_of_year: float | None = None
     ascending_node_local_time_h: float | None = None
     scale: float = 1.0
+    version: float = DEFAULT_MSIS_VERSION
 
     def __post_init__(self) -> None:
         low, high = F107_RANGE_SFU
@@ -358,6 +406,8 @@ class MsisAtmosphere:
         if self.ascending_node_local_time_h is not None:
             check_number(self.ascending_node_local_time_h, "ascending_node_local_time_h", unit="h", low=0.0, high=24.0)
         check_number(self.scale, "scale", low=0.0, low_inclusive=False)
+        # A float always (0 and 0.0 are one version, and one cache key).
+        object.__setattr__(self, "version", check_msis_version(self.version))
 
     def log_density_table(self) -> FloatArray:
         """ln(density [kg/m^3]) on ``ALTITUDE_GRID_M``, without ``scale`` (cached)."""
@@ -368,6 +418,7 @@ class MsisAtmosphere:
             float(self.inclination_deg),
             None if self.day_of_year is None else float(self.day_of_year),
             None if self.ascending_node_local_time_h is None else float(self.ascending_node_local_time_h),
+            self.version,
         )
 
     def density_kg_m3(self, altitude_m: ArrayLike) -> NDArray[np.float64]:
