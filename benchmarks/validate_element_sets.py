@@ -322,7 +322,15 @@ def parse_date(text: str) -> dt.datetime:
     return dt.datetime.fromisoformat(text.replace("Z", "+00:00")).astimezone(UTC)
 
 
-def predict(obj: SpaceObject, chosen: int, mode: str, sets: Sequence[int], samples: int | None, folder: Path) -> Case:
+def predict(
+    obj: SpaceObject,
+    chosen: int,
+    mode: str,
+    sets: Sequence[int],
+    samples: int | None,
+    folder: Path,
+    drag_from: str | None = None,
+) -> Case:
     """Run one case: the sets ``sets`` of ``obj`` in one file, predicted from set ``chosen``."""
     epoch = obj.sets[chosen].epoch
     base = {
@@ -339,6 +347,8 @@ def predict(obj: SpaceObject, chosen: int, mode: str, sets: Sequence[int], sampl
     path = folder / f"{obj.norad}_{chosen}_{mode.replace(' ', '_')}.tle"
     write_sets(path, obj.name, [obj.sets[k] for k in sets])
     argv = ["lifetime", "--tle", str(path), "--json"]
+    if drag_from and mode == "one set":
+        argv += ["--drag-from", drag_from]
     if samples:
         argv += ["--uncertainty", "--samples", str(samples)]
     clock = time.perf_counter()
@@ -370,7 +380,14 @@ def predict(obj: SpaceObject, chosen: int, mode: str, sets: Sequence[int], sampl
     )
 
 
-def run_cases(objects: Sequence[SpaceObject], *, history: bool, samples: int | None, limit: int | None) -> list[Case]:
+def run_cases(
+    objects: Sequence[SpaceObject],
+    *,
+    history: bool,
+    samples: int | None,
+    limit: int | None,
+    drag_from: str | None = None,
+) -> list[Case]:
     """Every chosen case of ``objects`` (one set, and the history if asked), with progress lines on stderr."""
     plan = [(obj, k) for obj in objects for k in choose_sets([obj.lead_days(i) for i in range(len(obj.sets))])]
     if limit is not None:
@@ -382,7 +399,7 @@ def run_cases(objects: Sequence[SpaceObject], *, history: bool, samples: int | N
             runs = [("one set", [k])] + ([("history", history_indices(epochs, k))] if history else [])
             notes = []
             for mode, sets in runs:
-                case = predict(obj, k, mode, sets, samples, Path(tmp))
+                case = predict(obj, k, mode, sets, samples, Path(tmp), drag_from)
                 cases.append(case)
                 what = f"{case.error:+.1%}" if case.status == "ok" else case.status
                 notes.append(f"{mode} ({len(sets)} sets) {what} in {case.seconds:.1f} s")
@@ -550,6 +567,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--samples", type=int, default=200, help="Monte Carlo samples of the band (default 200)")
     parser.add_argument("--limit-cases", type=int, metavar="N", help="run only the first N cases")
+    parser.add_argument(
+        "--drag-from", choices=("bstar", "ndot", "bstar-raw"), help="one set: what gives the drag (the CLI's option)"
+    )
     parser.add_argument("--out", metavar="CSV", help="write one row per case and mode")
     parser.add_argument("--plot", metavar="PNG", help="predicted against observed remaining life")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -569,7 +589,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     clock = time.perf_counter()
     cases = run_cases(
-        objects, history=args.history, samples=args.samples if args.uncertainty else None, limit=args.limit_cases
+        objects,
+        history=args.history,
+        samples=args.samples if args.uncertainty else None,
+        limit=args.limit_cases,
+        drag_from=args.drag_from,
     )
     total = time.perf_counter() - clock
     summary = summarize(cases)

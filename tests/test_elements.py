@@ -127,8 +127,18 @@ def test_cli_tle_json_reports_the_drag_parameter_and_its_source(capsys, tmp_path
     assert status == 0
     result = json.loads(out)
     elements = parse_tle(*CUBESAT[1:])
-    assert result["drag_parameter_source"] == "bstar"
-    assert result["drag_parameter_m2_kg"] == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-12)
+    # B* calibrated to the chosen air at the epoch (orbit_env.analysis.drag_calibration); the raw 2 B*/rho0
+    # is reported beside it and is what --drag-from bstar-raw uses.
+    assert result["drag_parameter_source"] == "bstar_calibrated"
+    assert result["drag_parameter_uncalibrated_m2_kg"] == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-12)
+    ratio = result["sgp4_to_air_density_ratio"]
+    assert result["drag_parameter_m2_kg"] == pytest.approx(elements.drag_parameter_m2_kg * ratio, rel=1e-12)
+    _, raw, _ = run(
+        capsys, "lifetime", "--tle", str(path), "--atmosphere", "paper", "--drag-from", "bstar-raw", "--json"
+    )
+    raw = json.loads(raw)
+    assert raw["drag_parameter_source"] == "bstar"
+    assert raw["drag_parameter_m2_kg"] == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-12)
     assert result["height_reference"] == "equatorial"
     # The orbit flown: the mean elements' heights moved by J2's offset (+4.5 km at 97.5 deg).
     assert result["perigee_km"] == pytest.approx(elements.flown_perigee_km)
@@ -139,7 +149,7 @@ def test_cli_tle_json_reports_the_drag_parameter_and_its_source(capsys, tmp_path
     api = lifetime(
         elements.flown_perigee_km + EQUATORIAL_OFFSET_KM,
         elements.flown_apogee_km + EQUATORIAL_OFFSET_KM,
-        satellite=Satellite(1.0, 1.0, elements.drag_parameter_m2_kg),
+        satellite=Satellite(1.0, 1.0, result["drag_parameter_m2_kg"]),
         method="curves",  # the command line's default on the curves
     )
     # Within the universal curves' own accuracy (0.5%, docs/validation.md): which table the curves come from
@@ -254,7 +264,11 @@ def test_batch_of_element_sets(capsys, tmp_path):
     elements = parse_tle(*CUBESAT[1:])
     # Heights of the orbit flown above the equatorial radius; c from B*; the inclination from the set.
     assert float(rows[0]["perigee_km"]) == pytest.approx(elements.flown_perigee_km, abs=1e-3)
-    assert float(rows[0]["drag_parameter_m2_kg"]) == pytest.approx(elements.drag_parameter_m2_kg, rel=1e-5)
+    # One set of its object: B* calibrated to the air, as for --tle (the same number).
+    path_one = tmp_path / "one.tle"
+    path_one.write_text("\n".join(CUBESAT) + "\n")
+    _, single, _ = run(capsys, "lifetime", "--tle", str(path_one), "--atmosphere", "paper", "--json")
+    assert float(rows[0]["drag_parameter_m2_kg"]) == pytest.approx(json.loads(single)["drag_parameter_m2_kg"], rel=1e-5)
     assert float(rows[0]["inclination_deg"]) == pytest.approx(97.5)
     assert rows[0]["status"] == "ok" and float(rows[0]["days"]) > 0
     # The ISS set's B* < 0: a status naming its line, and the batch goes on (exit 1: a row without a lifetime).

@@ -56,6 +56,9 @@ class ElementSet:
         inclination_deg: Inclination.
         bstar_per_earth_radius: SGP4's drag term B* [1/ER] (None: not from a TLE).
         line: The file's line number of the set's first line (0: not from a file).
+        ndot_rev_day2: The first derivative of the mean motion [rev/day^2], twice line 1's
+            ndot / 2 (None: not from a TLE).
+        catalogue_number: The satellite's catalogue number (line 1, columns 3-7; "" if none).
     """
 
     name: str
@@ -65,6 +68,8 @@ class ElementSet:
     inclination_deg: float
     bstar_per_earth_radius: float | None = None
     line: int = 0
+    ndot_rev_day2: float | None = None
+    catalogue_number: str = ""
 
     @property
     def perigee_km(self) -> float:
@@ -188,6 +193,8 @@ def parse_tle(
         inclination_deg=math.degrees(satrec.inclo),
         bstar_per_earth_radius=satrec.bstar,
         line=first_line,
+        ndot_rev_day2=2.0 * float(line1[33:43]),
+        catalogue_number=line1[2:7].strip(),
     )
 
 

@@ -58,6 +58,10 @@ SOLAR_FORECAST_SIGMA = 0.15
 DENSITY_MODEL_SIGMA = 0.15
 #: Log-normal sigma of the drag coefficient.
 DRAG_COEFFICIENT_SIGMA = 0.10
+#: Log-normal sigma of a drag parameter calibrated from one element set (B* or ndot): the scatter
+#: between sets of one object 1-15 days apart, 0.170 for B* and 0.174 for ndot over 91 pairs of 22
+#: objects (benchmarks/measure_drag_scatter.py, which uses no re-entry outcome).
+ONE_SET_DRAG_SIGMA = 0.17
 #: Values of the solar z at which the time-stepped decay runs; samples outside are extrapolated linearly.
 SOLAR_NODES = (-2.0, -1.0, 0.0, 1.0, 2.0)
 #: Percentiles reported.
@@ -126,13 +130,15 @@ class LifetimeSpread:
         return float(np.mean(self.reentered & (self.days <= years * 365.25)))
 
 
-def sample_factors(samples: int, seed: int) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The samples' solar z, density factor and drag-coefficient factor (seeded; the same twice)."""
+def sample_factors(
+    samples: int, seed: int, drag_sigma: float = DRAG_COEFFICIENT_SIGMA
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The samples' solar z, density factor and drag factor (sigma ``drag_sigma``; seeded: the same twice)."""
     n = check_int(samples, "samples", low=10, high=1_000_000)
     rng = np.random.default_rng(check_int(seed, "seed", low=0))
     z_sun = rng.standard_normal(n)
     density = np.exp(DENSITY_MODEL_SIGMA * rng.standard_normal(n))
-    drag = np.exp(DRAG_COEFFICIENT_SIGMA * rng.standard_normal(n))
+    drag = np.exp(drag_sigma * rng.standard_normal(n))
     return z_sun, density, drag
 
 
@@ -145,6 +151,7 @@ def lifetime_spread(
     *,
     samples: int = 1000,
     seed: int = 0,
+    drag_sigma: float = DRAG_COEFFICIENT_SIGMA,
 ) -> LifetimeSpread:
     """Monte Carlo lifetimes of one satellite (see the module docstring).
 
@@ -156,10 +163,13 @@ def lifetime_spread(
         inclination_deg: The orbit's inclination.
         samples: Number of samples.
         seed: Seed of the random numbers.
+        drag_sigma: Log-normal sigma of the drag parameter: `DRAG_COEFFICIENT_SIGMA` for a
+            satellite of known mass and area, `ONE_SET_DRAG_SIGMA` for one element set's.
     """
-    z_sun, density, drag = sample_factors(samples, seed)
+    z_sun, density, drag = sample_factors(samples, seed, drag_sigma)
     scale = density * drag
-    sources = {"density_model": DENSITY_MODEL_SIGMA, "drag_coefficient": DRAG_COEFFICIENT_SIGMA}
+    drag_key = "drag_coefficient" if drag_sigma == DRAG_COEFFICIENT_SIGMA else "drag_parameter"
+    sources = {"density_model": DENSITY_MODEL_SIGMA, drag_key: drag_sigma}
     if not scenario.time_varying:
         days, reentered = scenario.lifetime_days(perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
         return LifetimeSpread(float(days) / scale, np.full(scale.size, bool(reentered)), seed, sources)

@@ -159,7 +159,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         )
     band = None
     if args.uncertainty:
-        band = orbit_inputs.uncertainty(args, orbit, scenario, satellite, result, summary)
+        sigma = orbit_inputs.drag_sigma(drag_source, drag_report)
+        band = orbit_inputs.uncertainty(args, orbit, scenario, satellite, result, summary, sigma)
     if args.trajectory:
         write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset, result.epoch_days))
     if args.plot:
@@ -213,7 +214,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
         raise ValueError("--batch always uses the universal curves; do not give --method")
     check_output(args.out, args.batch, force=args.force)
     start = time.perf_counter()
-    rows, hp, ha, c, inc, status = orbit_inputs.read_orbits(args, satellite, read_batch)
+    rows, hp, ha, c, inc, status = orbit_inputs.read_orbits(args, satellite, read_batch, scenario)
     records, summary = batch_lifetimes(
         rows,
         hp,

@@ -14,12 +14,15 @@ and back for what is printed. Heavy imports (sgp4, pymsis) happen inside the fun
 from __future__ import annotations
 
 import argparse
+import math
 from dataclasses import dataclass
 from typing import Any
 
 from orbit_env.analysis.air import DATED_AIR, DEFAULT_AIR, air_model
+from orbit_env.analysis.drag_calibration import SOURCE_BSTAR_CALIBRATED
 from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
 from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
+from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.cli.common import given, number
 
 #: What ``drag_parameter_source`` says in JSON.
@@ -28,6 +31,10 @@ SOURCE_SATELLITE = "satellite"
 SOURCE_SHAPE = "shape"
 SOURCE_DEFAULT = "default"
 _SATELLITE_FLAGS = ("mass", "area", "mass_per_area", "cx", "shape")
+#: ``--drag-from``: what of an element set gives the drag parameter.
+DRAG_FROM_SOURCES = {"bstar": "bstar_calibrated", "ndot": "ndot_calibrated"}
+DRAG_FROM_DEFAULT = "bstar"
+DRAG_FROM_CHOICES = (*DRAG_FROM_SOURCES, "bstar-raw")
 
 
 @dataclass(frozen=True)
@@ -66,6 +73,12 @@ def add_orbit_options(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="two- or three-line element set ('-': stdin): epoch, mean elements (the decay starts from the orbit "
         "flown: J2's offset added), inclination, B*",
+    )
+    group.add_argument(
+        "--drag-from",
+        choices=DRAG_FROM_CHOICES,
+        help="with --tle and no satellite: the drag parameter from B* (default) or from ndot, calibrated to the "
+        "chosen air at the set's epoch; bstar-raw: 2 B*/rho0 against SGP4's own density (to compare)",
     )
     group.add_argument(
         "--semi-major-axis-km",
@@ -110,9 +123,16 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         if getattr(args, "batch", None):
             raise ValueError("give either --tle or --batch (a batch file may hold element sets)")
         sets = read_tle(tle)
-        if len(sets) > 1:
-            raise ValueError(f"{tle} holds {len(sets)} element sets; use --batch for more than one")
-        elements = sets[0]
+        numbers = sorted({s.catalogue_number for s in sets})
+        if len(numbers) > 1:
+            raise ValueError(
+                f"{tle} holds element sets of {len(numbers)} objects ({', '.join(numbers)}); one object's sets are "
+                "its history, several objects need --batch"
+            )
+        # Several sets of one object: a history; the prediction starts from the latest.
+        sets.sort(key=lambda s: s.epoch_days)
+        args.tle_history = sets if len(sets) > 1 else None
+        elements = sets[-1]
         if args.epoch is None and "epoch" in air_model(args.atmosphere or DATED_AIR).options:
             args.epoch = elements.epoch_iso.rstrip("Z")
         if args.inclination is None:
@@ -171,18 +191,58 @@ def satellite_from_args(
         return make_satellite(cx, args.mass, body.reference_area_m2), SOURCE_SHAPE, report
     satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
     elements = orbit.elements
+    history = getattr(args, "tle_history", None)
+    if not satellite_given and history is not None:
+        from orbit_env.analysis.drag_calibration import SOURCE_HISTORY_FIT, fit_history
+
+        if getattr(args, "drag_from", None) is not None:
+            raise ValueError("--drag-from chooses what one element set gives; a history's drag is fitted to its decay")
+        fit = fit_history(history, scenario.in_sphere_heights(orbit.reference, args.inclination))
+        report["drag_fit"] = fit.report()
+        return Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, report
     if not satellite_given and elements is not None and elements.bstar_per_earth_radius is not None:
+        c, source = _drag_from_elements(args, elements, scenario.in_sphere_heights(orbit.reference, args.inclination))
+        report["bstar_per_earth_radius"] = elements.bstar_per_earth_radius
+        report["ndot_rev_day2"] = elements.ndot_rev_day2
+        if isinstance(c, tuple):  # calibrated: (c, DragCalibration)
+            c, calibration = c
+            report.update(calibration.report())
+        # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
+        return Satellite(1.0, 1.0, c), source, report
+    satellite = make_satellite(cx, args.mass, args.area, args.mass_per_area)
+    return satellite, SOURCE_SATELLITE if satellite_given else SOURCE_DEFAULT, report
+
+
+def _drag_from_elements(args: argparse.Namespace, elements: Any, scenario: Any) -> tuple[Any, str]:
+    """The drag parameter an element set carries (``--drag-from``), and its source's name.
+
+    Raises:
+        ValueError: the set carries no decay (B* or ndot not above zero): give the satellite.
+    """
+    from orbit_env.analysis.drag_calibration import SOURCE_NDOT_CALIBRATED, calibrate
+
+    how = getattr(args, "drag_from", None) or DRAG_FROM_DEFAULT
+    if how == "bstar-raw":
         c = elements.drag_parameter_m2_kg
         if c is None:
             raise ValueError(
                 f"the element set's B* = {elements.bstar_per_earth_radius:g} /ER gives no drag parameter "
                 "(it must be above 0); give the satellite: --mass and --area (or --shape)"
             )
-        report["bstar_per_earth_radius"] = elements.bstar_per_earth_radius
-        # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
-        return Satellite(1.0, 1.0, c), SOURCE_BSTAR, report
-    satellite = make_satellite(cx, args.mass, args.area, args.mass_per_area)
-    return satellite, SOURCE_SATELLITE if satellite_given else SOURCE_DEFAULT, report
+        return c, SOURCE_BSTAR
+    source = DRAG_FROM_SOURCES[how]
+    calibration = calibrate(elements, scenario, source=source)
+    if calibration is None:
+        value = (
+            f"ndot = {elements.ndot_rev_day2:g} rev/day^2"
+            if source == SOURCE_NDOT_CALIBRATED
+            else f"B* = {elements.bstar_per_earth_radius:g} /ER"
+        )
+        raise ValueError(
+            f"the element set's {value} gives no drag parameter (it must be above 0); give the satellite: "
+            "--mass and --area (or --shape)"
+        )
+    return (calibration.drag_parameter_m2_kg, calibration), calibration.source
 
 
 def _shape_drag_coefficient(body: Any, orbit: OrbitInput, scenario: Any, args: argparse.Namespace) -> Any:
@@ -272,7 +332,22 @@ def satellite_line(satellite: Satellite, source: str, report: dict[str, Any]) ->
     if source == SOURCE_BSTAR:
         return (
             f"satellite          c_x A/m = {c:.4g} m^2/kg from the element set's B* = "
-            f"{report['bstar_per_earth_radius']:.5g} /ER (2 B* / 0.15696615)"
+            f"{report['bstar_per_earth_radius']:.5g} /ER (2 B* / 0.15696615, against SGP4's own density)"
+        )
+    if "drag_fit" in report:
+        fit = report["drag_fit"]
+        return (
+            f"satellite          c_x A/m = {c:.4g} m^2/kg fitted to the decay between {fit['sets']} element sets over "
+            f"{fit['span_days']:.1f} days (residual {fit['residual_km'] * 1e3:.0f} m, c within "
+            f"{100 * fit['sigma_ln']:.1f}% at 1 sigma); from the latest set"
+        )
+    if "sgp4_to_air_density_ratio" in report:
+        what = "B*" if source == SOURCE_BSTAR_CALIBRATED else "ndot"
+        return (
+            f"satellite          c_x A/m = {c:.4g} m^2/kg from one element set's {what}, calibrated to this air at its "
+            f"epoch (SGP4's density {report['sgp4_to_air_density_ratio']:.3g} x this air's; 2 B*/rho0 = "
+            f"{report['drag_parameter_uncalibrated_m2_kg']:.4g}); one set: uncertain by a factor of "
+            f"{math.exp(ONE_SET_DRAG_SIGMA):.2g} (1 sigma)"
         )
     text = (
         f"satellite          c_x {satellite.drag_coefficient:.4g}, {satellite.mass_kg:g} kg, "
@@ -299,14 +374,17 @@ def history_rows(history: Any, offset: float, epoch_days: float | None = None) -
     return rows
 
 
-def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any) -> tuple[Any, ...]:
+def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any, scenario: Any) -> tuple[Any, ...]:
     """A batch file's orbits in the sphere's heights [m]: a CSV (see ``catalogue``) or element sets.
 
-    Element sets give heights above the equatorial radius, their inclination, and the drag
-    parameter from B* unless the satellite is given on the command line.
+    Element sets give the heights of the orbit flown above the equatorial radius, their
+    inclination and, unless the satellite is given on the command line, the drag parameter:
+    each object's sets are its history (one row, from its latest set, the drag fitted to the
+    decay between its sets), an object with one set has its B* calibrated to the air.
     """
     import numpy as np
 
+    from orbit_env.analysis.drag_calibration import calibrate, fit_history
     from orbit_env.analysis.elements import looks_like_tle, read_tle
 
     if looks_like_tle(args.batch) and not getattr(args, "height_reference_given", False):
@@ -319,29 +397,41 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any)
         return rows, hp + offset_m, ha + offset_m, c, inc, status
     if args.height_reference != "equatorial":
         raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
-    sets = read_tle(args.batch)
+    histories: dict[str, list[Any]] = {}
+    for s in read_tle(args.batch):
+        histories.setdefault(s.catalogue_number, []).append(s)
+    objects = [sorted(sets, key=lambda s: s.epoch_days) for sets in histories.values()]
+    latest = [sets[-1] for sets in objects]
     satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
-    rows = [{"name": s.name} for s in sets]
-    hp = np.array([s.flown_perigee_km for s in sets]) * 1e3 + offset_m
-    ha = np.array([s.flown_apogee_km for s in sets]) * 1e3 + offset_m
-    inc = np.array([s.inclination_deg for s in sets])
-    c = np.full(len(sets), satellite.drag_parameter_m2_kg)
-    status = ["ok"] * len(sets)
-    for i, s in enumerate(sets):
-        if not satellite_given:
-            value = s.drag_parameter_m2_kg
-            if value is None:
-                status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
+    rows = [{"name": s.name} for s in latest]
+    hp = np.array([s.flown_perigee_km for s in latest]) * 1e3 + offset_m
+    ha = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
+    inc = np.array([s.inclination_deg for s in latest])
+    c = np.full(len(latest), satellite.drag_parameter_m2_kg)
+    status = ["ok"] * len(latest)
+    air = scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0))
+    for i, (s, sets) in enumerate(zip(latest, objects, strict=True)):
+        if satellite_given:
+            continue
+        try:
+            if len(sets) > 1:
+                c[i] = fit_history(sets, air).drag_parameter_m2_kg
             else:
-                c[i] = value
+                calibration = calibrate(s, air)
+                if calibration is None:
+                    status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
+                else:
+                    c[i] = calibration.drag_parameter_m2_kg
+        except ValueError as error:
+            status[i] = f"line {s.line}: {error}"
     from orbit_env.decay.curves import UniversalCurves
 
-    for i in range(len(sets)):
+    for i in range(len(latest)):
         if status[i] == "ok":
             try:
                 UniversalCurves.check_domain(hp[i], ha[i])
             except ValueError as error:
-                status[i] = f"line {sets[i].line}: {error}"
+                status[i] = f"line {latest[i].line}: {error}"
     return rows, hp, ha, c, inc, status
 
 
@@ -373,7 +463,13 @@ def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
 
 
 def uncertainty(
-    args: argparse.Namespace, orbit: OrbitInput, scenario: Any, satellite: Satellite, result: Any, summary: dict
+    args: argparse.Namespace,
+    orbit: OrbitInput,
+    scenario: Any,
+    satellite: Satellite,
+    result: Any,
+    summary: dict,
+    drag_sigma: float | None = None,
 ) -> tuple[float, float] | None:
     """Run ``--uncertainty``; add its keys to ``summary``; return the 5-95% band [days] for the plot."""
     from orbit_env.analysis.uncertainty import lifetime_spread, spread_report
@@ -387,6 +483,7 @@ def uncertainty(
         args.inclination,
         samples=args.samples,
         seed=args.seed,
+        **({} if drag_sigma is None else {"drag_sigma": drag_sigma}),
     )
     epoch = result.epoch_days
     if epoch is None and orbit.elements is not None:
@@ -394,6 +491,20 @@ def uncertainty(
     summary.update(spread_report(spread, epoch, args.rule))
     low, high = summary["days_percentiles"]["5"], summary["days_percentiles"]["95"]
     return None if low is None or high is None else (low, high)
+
+
+def drag_sigma_of(source: str) -> float | None:
+    """The drag parameter's log-normal sigma by its source (None: the default, a known satellite's C_D)."""
+    from orbit_env.analysis.drag_calibration import SOURCE_NDOT_CALIBRATED
+
+    return ONE_SET_DRAG_SIGMA if source in (SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, SOURCE_BSTAR) else None
+
+
+def drag_sigma(source: str, report: dict[str, Any]) -> float | None:
+    """The drag parameter's log-normal sigma: a history's from its fit, one set's measured, else the default."""
+    if "drag_fit" in report:
+        return float(report["drag_fit"]["sigma_ln"])
+    return drag_sigma_of(source)
 
 
 def uncertainty_lines(summary: dict[str, Any]) -> list[str]:

@@ -22,6 +22,9 @@ from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
+import numpy as np
+from numpy.typing import NDArray
+
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.curves import UniversalCurves, universal_curves
 from orbit_env.decay.solar import ConstantActivity, SolarActivity
@@ -85,6 +88,16 @@ class Air(ABC):
     def curves(self, model: DecayModel) -> UniversalCurves:
         """The universal curves of this air's decay model (cached per process and on disk)."""
         return universal_curves(model)
+
+    def density_near_kg_m3(
+        self, altitude_m: Any, inclination_deg: float, epoch_days: float | None, span_days: int
+    ) -> NDArray[np.float64]:
+        """The orbit-averaged density [kg/m^3] at altitudes above the 6371 km sphere, over the days before a date.
+
+        A fixed profile is the same on every date; a dated air averages its days
+        ``epoch_days - span_days + 1 .. epoch_days`` (the air an element set was fitted in).
+        """
+        return np.asarray(self.profile(inclination_deg).density_kg_m3(altitude_m), dtype=np.float64)
 
     def in_sphere_heights(self, reference: str, inclination_deg: float) -> Air:
         """The same air as a law in heights above the 6371 km sphere, for heights quoted above ``reference``."""

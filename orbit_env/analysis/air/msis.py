@@ -166,6 +166,30 @@ class MsisAir(Air):
         """Its own activity, on its epoch."""
         return self.solar, self.epoch_days
 
+    def density_near_kg_m3(
+        self, altitude_m: Any, inclination_deg: float, epoch_days: float | None, span_days: int
+    ) -> Any:
+        """Dated: the mean of each day's orbit-averaged density over the span, with the days' indices (and season)."""
+        if not self.dated or epoch_days is None:
+            return super().density_near_kg_m3(altitude_m, inclination_deg, epoch_days, span_days)
+        import numpy as np
+
+        from orbit_env.decay.solar import day_of_year
+        from orbit_env.physics.atmosphere.msis import mean_density_over_days_kg_m3
+
+        days = float(epoch_days) - np.arange(span_days)[::-1]
+        f107, f107a, ap = self.solar.indices(days)
+        return mean_density_over_days_kg_m3(
+            altitude_m,
+            f107,
+            f107a,
+            ap,
+            day_of_year(days),
+            inclination_deg,
+            self.ascending_node_local_time_h,
+            version=self.version,
+        )
+
     def mean_density_over_inclinations_kg_m3(self, altitude_m: Any, inclinations_deg: Any, **nodes: Any) -> Any:
         """`orbit_env.physics.atmosphere.msis.mean_density_over_inclinations_kg_m3` of constant activity."""
         from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3

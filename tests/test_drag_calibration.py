@@ -1,0 +1,183 @@
+"""The drag an element set carries: B* read against SGP4's density, calibrated to the prediction's air, histories."""
+
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("sgp4")
+
+from sgp4.api import WGS72, Satrec
+
+from orbit_env.analysis.air import MsisAir, PaperAir, ProfileAir
+from orbit_env.analysis.drag_calibration import (
+    air_drag_rate,
+    calibrate,
+    fit_history,
+    sgp4_density_kg_m3,
+)
+from orbit_env.analysis.elements import ElementSet
+from orbit_env.analysis.scenario import Scenario
+from orbit_env.constants import MU_EARTH_M3_S2
+from orbit_env.decay.solar import ConstantActivity
+from orbit_env.physics.atmosphere import FunctionAtmosphere
+
+
+def satrec_at(height_km, bstar, eccentricity=0.0005):
+    satrec = Satrec()
+    n_rad_min = math.sqrt(398600.8 / (6378.135 + height_km) ** 3) * 60.0
+    satrec.sgp4init(WGS72, "i", 1, 24000.0, bstar, 0.0, 0.0, eccentricity, 0.5, math.radians(51.6), 0.2, n_rad_min, 0.7)
+    return satrec
+
+
+def sgp4_mean_a_m(satrec, days):
+    satrec.sgp4(satrec.jdsatepoch, satrec.jdsatepochF + days)
+    return satrec.am * satrec.radiusearthkm * 1e3
+
+
+@pytest.mark.parametrize(("height_km", "bstar"), [(140.0, 5e-6), (250.0, 2e-5), (400.0, 1e-4), (550.0, 3e-4)])
+def test_bstar_against_our_reading_of_sgp4s_density_gives_sgp4s_own_decay(height_km, bstar):
+    # SGP4's mean semi-major axis falls by some 40-100 m a day here; our reading of B* (C_D A/m = 2 B*/rho0
+    # with SGP4's power-law density, rho0 at 120 km, s lowered under a 156 km perigee) and the orbit average
+    # da/dt = -(a^2/mu) c <rho v^3> give the same drop within 1-2% (measured). 5% holds that; a wrong
+    # reference density, exponent or s moves it by far more (s = 78 km at 140 km: a factor of ~3).
+    satrec = satrec_at(height_km, bstar)
+    drop_m = sgp4_mean_a_m(satrec, 0.0) - sgp4_mean_a_m(satrec, 1.0 if height_km > 200 else 0.2)
+    days = 1.0 if height_km > 200 else 0.2
+    a_m, e = satrec.a * satrec.radiusearthkm * 1e3, satrec.ecco
+    sgp4_air = Scenario(ProfileAir(FunctionAtmosphere(lambda h: sgp4_density_kg_m3(h + 6371e3, a_m * (1 - e)))))
+    c = 2.0 * bstar / 0.15696615
+    ours_m = a_m * a_m / MU_EARTH_M3_S2 * c * air_drag_rate(sgp4_air, a_m, e, 51.6, None) * 86400.0 * days
+    assert drop_m == pytest.approx(ours_m, rel=0.05)
+
+
+def test_calibration_makes_the_air_reproduce_the_sets_decay():
+    # Whatever the air, the calibrated c times the air's drag rate is 2 B*/rho0 times SGP4's: the set's decay.
+    elements = ElementSet("test", 19000.0, 6378.137 + 500.0, 0.001, 97.5, 2e-4, 1, 1e-5, "99999")
+    for scenario in (
+        Scenario(PaperAir()),
+        Scenario(MsisAir(ConstantActivity(70.0, 70.0, 5.0))),
+        Scenario(MsisAir(ConstantActivity(250.0, 250.0, 30.0)), density_scale=2.0),
+    ):
+        result = calibrate(elements, scenario)
+        flown_a_m = (elements.semi_major_axis_km + elements.flown_offset_km) * 1e3
+        ours = result.drag_parameter_m2_kg * air_drag_rate(scenario, flown_a_m, 0.001, 97.5, 19000.0)
+        q = elements.semi_major_axis_km * 1e3 * 0.999
+        sgp4_air = Scenario(ProfileAir(FunctionAtmosphere(lambda h, q=q: sgp4_density_kg_m3(h + 6371e3, q))))
+        sgp4 = elements.drag_parameter_m2_kg * air_drag_rate(
+            sgp4_air, elements.semi_major_axis_km * 1e3, 0.001, 97.5, None
+        )
+        assert ours == pytest.approx(sgp4, rel=1e-9)
+    # In a quiet Sun at 500 km SGP4's static density is several times the real air's: the calibration
+    # raises c by that factor (the reason the raw 2 B*/rho0 puts re-entries centuries late).
+    quiet = calibrate(elements, Scenario(MsisAir(ConstantActivity(70.0, 70.0, 5.0))))
+    assert quiet.density_ratio > 3.0 and quiet.drag_parameter_m2_kg > 3.0 * elements.drag_parameter_m2_kg
+
+
+def test_a_history_fit_recovers_the_drag_of_a_decay_made_in_the_same_air():
+    # Element sets made from the model's own decay (the semi-major axis dropped by c times the air's rate)
+    # give back c; the fit's residual is then zero.
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
+    c_true, a0_km = 0.02, 6378.137 + 400.0
+    sets, a_km = [], a0_km
+    for day in range(0, 31, 3):
+        sets.append(ElementSet("x", 20000.0 + day, a_km, 0.0005, 51.6, 1e-4, 1, 1e-5, "11111"))
+        flown_a_m = (a_km + sets[-1].flown_offset_km) * 1e3
+        rate = flown_a_m**2 / MU_EARTH_M3_S2 * air_drag_rate(scenario, flown_a_m, 0.0005, 51.6, None)
+        a_km -= c_true * rate * 3 * 86400.0 / 1e3
+    fit = fit_history(sets, scenario)
+    # The fit interpolates a between the sets and steps daily: within 1%.
+    assert fit.drag_parameter_m2_kg == pytest.approx(c_true, rel=0.01)
+    assert fit.sets == 11 and fit.span_days == pytest.approx(30.0)
+    with pytest.raises(ValueError, match="of 11111, 22222"):
+        fit_history([*sets, ElementSet("y", 20001.0, a0_km, 0.0005, 51.6, 1e-4, 1, 1e-5, "22222")], scenario)
+    rising = [ElementSet("x", 20000.0 + k, a0_km + k, 0.0005, 51.6, 1e-4, 1, 1e-5, "11111") for k in range(3)]
+    with pytest.raises(ValueError, match="does not fall"):
+        fit_history(rising, scenario)
+
+
+def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():
+    # A set whose ndot is SGP4's own decay rate of B* gives the same calibrated c from either.
+    satrec = satrec_at(400.0, 1e-4)
+    a0, a1 = sgp4_mean_a_m(satrec, 0.0), sgp4_mean_a_m(satrec, 1.0)
+    n = lambda a: math.sqrt(MU_EARTH_M3_S2 / a**3) * 86400.0 / (2 * math.pi)  # noqa: E731
+    ndot = n(a1) - n(a0)  # rev/day^2 over one day
+    a_km = satrec.a * satrec.radiusearthkm
+    elements = ElementSet("t", 20000.0, a_km, satrec.ecco, 51.6, 1e-4, 1, ndot, "1")
+    scenario = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
+    from_bstar = calibrate(elements, scenario).drag_parameter_m2_kg
+    from_ndot = calibrate(elements, scenario, source="ndot_calibrated").drag_parameter_m2_kg
+    # The two differ by the 1-2% between SGP4's decay and our reading of it (test above): 5%.
+    assert from_ndot == pytest.approx(from_bstar, rel=0.05)
+    assert np.isfinite(from_bstar)
+
+
+# ---- the command line on real element sets (benchmarks/data/reentry_tles, sources in its README)
+
+DATA = __import__("pathlib").Path(__file__).resolve().parent.parent / "benchmarks" / "data" / "reentry_tles"
+
+
+def real_sets(norad, last, count):
+    """The ``count`` sets of object ``norad`` ending with its ``last``-th set (negative: from the end), as text."""
+    from orbit_env.analysis.elements import read_tle
+
+    path = next(DATA.glob(f"{norad}_*.tle"))
+    lines = path.read_text().splitlines()
+    sets = read_tle(path)
+    end = len(sets) + last + 1 if last < 0 else last + 1
+    chosen = sets[end - count : end]
+    return "\n".join(f"{lines[s.line - 1]}\n{lines[s.line]}" for s in chosen) + "\n", chosen[-1]
+
+
+def run_json(capsys, *argv):
+    import json
+
+    from orbit_env.cli import main
+
+    status = main(["lifetime", *argv, "--json"])
+    out, err = capsys.readouterr()
+    return status, (json.loads(out) if status == 0 else None), err
+
+
+@pytest.mark.parametrize(
+    ("norad", "reentry", "count"),
+    [
+        # BEESAT-4: SATCAT decay 2023-09-23; its last sets, 34-78 days before (objects.csv).
+        (41619, "2023-09-23T12:00", 4),
+        # CZ-5B Y2 core stage: 2021-05-09T02:14Z (18 SPCS); its sets 7.6-9.7 days before.
+        (48275, "2021-05-09T02:14", 8),
+        # AAUSAT 4: SATCAT decay 2023-09-06; its last sets.
+        (41460, "2023-09-06T12:00", 4),
+    ],
+)
+def test_real_reentries_from_one_set_and_from_a_history(capsys, tmp_path, norad, reentry, count):
+    # The re-entry goal of issue 27 for a history is +-25% of the remaining life for 90% of the cases and
+    # for one set a median of 20%: each of these three, predicted from the latest set (one set) and from
+    # the history of the last sets, lands within +-25% of the observed remaining life.
+    from orbit_env.decay.solar import unix_days
+
+    text, latest = real_sets(norad, -1, count)
+    history = tmp_path / "history.tle"
+    history.write_text(text)
+    one = tmp_path / "one.tle"
+    one.write_text("\n".join(text.splitlines()[-2:]) + "\n")
+    observed = unix_days(reentry) - latest.epoch_days
+    status, result, err = run_json(capsys, "--tle", str(history))
+    assert status == 0, err
+    assert result["drag_parameter_source"] == "history_fit" and result["drag_fit"]["sets"] >= 2
+    assert result["days"] == pytest.approx(observed, rel=0.25)
+    status, result, err = run_json(capsys, "--tle", str(one))
+    if latest.bstar_per_earth_radius > 0:
+        assert status == 0, err
+        assert result["drag_parameter_source"] == "bstar_calibrated"
+        assert result["days"] == pytest.approx(observed, rel=0.25)
+
+
+def test_several_objects_in_one_file_are_an_error_naming_them(capsys, tmp_path):
+    first, _ = real_sets(41619, -1, 1)
+    second, _ = real_sets(41460, -1, 1)
+    path = tmp_path / "two.tle"
+    path.write_text(first + second)
+    status, _, err = run_json(capsys, "--tle", str(path))
+    assert status == 2
+    assert "2 objects (41460, 41619)" in err and "--batch" in err
