@@ -25,9 +25,9 @@ Modes, both through the package's command line run in-process
 * one set: a file holding the chosen set (a name line and its two lines);
 * history (``--history``): a file holding the object's sets with epochs from 60 days before the chosen
   set's epoch up to it, the chosen set last; where there are more than 30, 30 evenly spaced in file
-  order, always keeping the oldest and the chosen one. A history of one set is not run. While the
-  command refuses several sets without ``--batch`` (exit status 2, "... use --batch ..."), the case is
-  recorded as "history not supported"; the script uses histories as soon as the command accepts them.
+  order, always keeping the oldest and the chosen one. A history of one set is not run ("one set
+  only"). A command that refuses several sets without ``--batch`` (exit status 2, "... use --batch ...")
+  makes the case "history not supported" rather than an error.
 
 With ``--uncertainty`` (default on) the same run adds ``--uncertainty --samples N``: the prediction is
 read from ``days`` and the 90% band from ``reentry_date_percentiles`` ("5" to "95"), counted from the
@@ -121,6 +121,7 @@ class Case:
     band_days: tuple[float, float] = (math.nan, math.nan)
     reentered: bool | None = None
     drag_parameter_source: str = ""
+    fit_sets: int | None = None  # the sets the command's history fit used (JSON drag_fit.sets)
     seconds: float = 0.0
 
     @property
@@ -376,6 +377,7 @@ def predict(
         band_days=band,
         reentered=summary.get("reentered"),
         drag_parameter_source=str(summary.get("drag_parameter_source", "")),
+        fit_sets=(summary.get("drag_fit") or {}).get("sets"),
         seconds=seconds,
     )
 
@@ -471,6 +473,7 @@ def write_rows(cases: Sequence[Case], path: str) -> None:
         "in_band",
         "reentered",
         "drag_parameter_source",
+        "fit_sets",
         "seconds",
     ]
     with open(path, "w", newline="") as handle:
@@ -493,6 +496,7 @@ def write_rows(cases: Sequence[Case], path: str) -> None:
                     "in_band": "" if c.in_band is None else c.in_band,
                     "reentered": "" if c.reentered is None else c.reentered,
                     "drag_parameter_source": c.drag_parameter_source,
+                    "fit_sets": "" if c.fit_sets is None else c.fit_sets,
                     "seconds": f"{c.seconds:.2f}",
                 }
             )
