@@ -1,0 +1,70 @@
+"""README's examples run: its Python examples as doctests, its fast console examples as printed.
+
+README states what the package prints; these tests hold it to that, so a changed number
+in the code or in README fails here. Slow or machine-dependent blocks (``orbit-env
+evaluate``'s first run solves the DP; the benchmarks' timings) are not run: `SLOW` names them.
+"""
+
+import contextlib
+import doctest
+import io
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from orbit_env.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+README = (ROOT / "README.md").read_text()
+HOWTO = (ROOT / "docs" / "how-to" / "lifetime.md").read_text()
+#: Console commands README shows but these tests do not run, and why.
+SLOW = {
+    "orbit-env evaluate": "solves the DP optimum on a cold cache (tens of seconds); tests/test_agents.py scores it",
+    "python benchmarks/bench_all.py": "timings depend on the machine",
+}
+
+
+def blocks(text, language):
+    return re.findall(rf"^```{language}\n(.*?)^```", text, flags=re.S | re.M)
+
+
+def console_examples():
+    for block in blocks(README, "console"):
+        command, *output = block.rstrip("\n").split("\n")
+        assert command.startswith("$ "), block
+        if not any(command[2:].startswith(slow) for slow in SLOW):
+            yield pytest.param(command[2:], output, id=command[2:60])
+
+
+def test_readme_has_python_and_console_examples():
+    assert len(blocks(README, "python")) >= 2 and len(list(console_examples())) >= 3
+
+
+@pytest.mark.parametrize("block", blocks(README, "python"), ids=lambda b: b.splitlines()[1][:50])
+def test_readme_python_examples(block):
+    test = doctest.DocTestParser().get_doctest(block, {}, "README.md", "README.md", 0)
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
+    out = io.StringIO()
+    runner.run(test, out=out.write)
+    assert runner.failures == 0, out.getvalue()
+
+
+@pytest.mark.parametrize(("command", "expected"), list(console_examples()))
+def test_readme_console_examples(command, expected, tmp_path, monkeypatch):
+    # The element set README uses is the synthetic one of docs/how-to/lifetime.md's `cat cubesat.tle`.
+    cat = re.search(r"^\$ cat cubesat\.tle\n(.*?)^\$ ", HOWTO, flags=re.S | re.M)
+    (tmp_path / "cubesat.tle").write_text(cat.group(1))
+    monkeypatch.chdir(tmp_path)
+    argv, _, pipe = command.partition(" | ")
+    words = shlex.split(argv)
+    assert words[0] == "orbit-env"
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(words[1:]) == 0
+    lines = out.getvalue().rstrip("\n").split("\n")
+    if pipe:
+        assert pipe.startswith("tail -")
+        lines = lines[-int(pipe.split("-")[1]) :]
+    assert lines == expected
