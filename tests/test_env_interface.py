@@ -7,6 +7,9 @@ without a display, outcome keys in ``info``).
 
 from __future__ import annotations
 
+import copy
+from typing import Any
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -283,3 +286,128 @@ def test_a_reset_env_pickles_small_and_continues_identically(env_id):
     vec.reset(seed=4)
     vec.step(vec.action_space.sample())
     assert len(pickle.dumps(vec.unwrapped)) < 200_000  # 64 satellites' rows, no table
+
+
+# --------------------------------------------------------------------------------------
+# A start can be replayed: env.unwrapped.start_options gives it back bit for bit
+# --------------------------------------------------------------------------------------
+
+
+def _fixed_actions(env: gym.Env, kind: str, n: int) -> list:
+    """``n`` actions: all coasts, or a random sequence fixed by its own seed."""
+    space = env.action_space
+    if kind == "coast":
+        return [np.full(space.shape, -1.0, dtype=np.float32) if space.shape else 0 for _ in range(n)]
+    space = copy.deepcopy(space)
+    space.seed(7)
+    return [space.sample() for _ in range(n)]
+
+
+def _episode(env: gym.Env, actions: list, **reset: Any) -> tuple[np.ndarray, float, int]:
+    """Reset, then step ``actions`` to the episode's end: the start's fields, the return, the steps."""
+    from orbit_env.envs.state import STATE_FIELDS
+
+    env.reset(**reset)
+    start = np.array([getattr(env.unwrapped.task_state, name) for name in STATE_FIELDS])
+    total = 0.0
+    for k, action in enumerate(actions):
+        _, reward, terminated, truncated, _ = env.step(action)
+        total += reward
+        if terminated or truncated:
+            return start, total, k + 1
+    raise AssertionError("the episode outlived its actions")
+
+
+@pytest.mark.parametrize("kind", ["coast", "random"])
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_a_drawn_start_replays_bit_for_bit_from_its_start_options(env_id, kind):
+    # The reported heights do not give a start back (table A locates table B's heights a little
+    # elsewhere: up to 30 m of perigee, 0.5 km of apogee, 0.3 day of return); the start options do.
+    env = gym.make(env_id)
+    actions = _fixed_actions(env, kind, DEFAULT_HORIZON_STEPS)
+    for seed in range(100):
+        start, total, steps = _episode(env, actions, seed=seed)
+        options = env.unwrapped.start_options
+        assert set(options) == {"curve_label", "curve_tau", "density_scale", "density_phase_rad"} | {
+            "drag_coefficient",
+            "area_m2",
+            "dry_mass_kg",
+            "propellant_mass_kg",
+            "isp_s",
+        }
+        # Replayed from another state of the generator: nothing of the start is drawn.
+        again, total_again, steps_again = _episode(env, actions, options=options)
+        np.testing.assert_array_equal(again, start, err_msg=f"seed {seed}")
+        assert abs(total_again - total) <= 1e-9 and steps_again == steps, (seed, total, total_again)
+        assert env.unwrapped.start_options == options
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_vector_starts_replay_bit_for_bit_automatic_resets_included(env_id):
+    from orbit_env.envs.state import STATE_FIELDS
+
+    n = 100
+    env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", horizon_steps=40)
+    single = gym.make(env_id, horizon_steps=40)
+    rng = np.random.default_rng(3)
+
+    def actions() -> np.ndarray:
+        if env.single_action_space.shape:
+            return rng.uniform(-1.0, 1.0, (n, 1)).astype(np.float32)
+        return rng.integers(0, 4, n)
+
+    env.reset(seed=0)
+    starts = env.unwrapped.task_state.data.copy()
+    done = np.zeros(n, dtype=bool)
+    for _ in range(60):  # every satellite ends once (truncation at 40), most restart automatically
+        _, _, terminated, truncated, _ = env.step(actions())
+        starts[:, done] = env.unwrapped.task_state.data[:, done]  # restarted in this step (NEXT_STEP)
+        done = terminated | truncated
+    options = env.unwrapped.start_options
+    assert all(value.shape == (n,) for value in options.values())
+    fixed = [actions() for _ in range(40)]
+
+    def play() -> tuple[np.ndarray, np.ndarray]:
+        env.reset(options=options)
+        first = env.unwrapped.task_state.data.copy()
+        total, over = np.zeros(n), np.zeros(n, dtype=bool)
+        for action in fixed:
+            _, reward, terminated, truncated, _ = env.step(action)
+            total += np.where(over, 0.0, reward)
+            over |= terminated | truncated
+        return first, total
+
+    first, total = play()
+    np.testing.assert_array_equal(first[: len(STATE_FIELDS)], starts[: len(STATE_FIELDS)])
+    again, total_again = play()
+    np.testing.assert_array_equal(again, first)
+    np.testing.assert_allclose(total_again, total, rtol=0.0, atol=1e-9)
+    # Row i's options start sub-environment i's mission in a single environment.
+    for i in range(0, n, 10):
+        single.reset(options={name: value[i] for name, value in options.items()})
+        state = single.unwrapped.task_state
+        for row, name in enumerate(STATE_FIELDS[:8]):
+            assert getattr(state, name) == pytest.approx(first[row, i], rel=1e-12, abs=1e-9), name
+
+
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        ({"curve_label": 1.0, "curve_tau": 5.0}, r"curve_label(\[0\])?=1 is out of range; allowed: -20.7\d* to -1.3"),
+        ({"curve_label": -5.0, "curve_tau": -0.5}, r"curve_tau(\[0\])?=-0.5 is out of range; allowed: at least 0"),
+        ({"curve_label": -5.0, "curve_tau": float("nan")}, r"reset option curve_tau=.*nan.* must be finite"),
+        ({"curve_label": -5.0}, r"reset option curve_label needs \['curve_label', 'curve_tau'\] together"),
+        ({"curve_tau": 5.0}, r"reset option curve_tau needs \['curve_label', 'curve_tau'\] together"),
+        ({"curve_label": -5.0, "curve_tau": 5.0, "perigee_km": 300.0}, r"\['perigee_km'\] and .* both pin the orbit"),
+        # Past the domain's top: the point's heights are out of it.
+        ({"curve_label": -5.0, "curve_tau": 26.0}, r"curve_tau(\[0\])?=26\.0.*outside the universal curves' domain"),
+        ({"curve_label": -5.0, "curve_tau": 5.0, "density_scale": 0.0}, r"density_scale(\[0\])?=0 is out of range"),
+    ],
+)
+def test_bad_curve_options_are_refused_naming_the_key(options, named):
+    env = gym.make("OrbitRaising-v0")
+    with pytest.raises(ValueError, match=named):
+        env.reset(seed=0, options=options)
+    vec = gym.make_vec("OrbitRaising-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    with pytest.raises(ValueError, match=named):
+        vec.reset(seed=0, options={key: np.full(3, value) for key, value in options.items()})

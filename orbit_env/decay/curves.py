@@ -632,7 +632,7 @@ class UniversalCurves:
 
         For two floats (one orbit): floats, and the cell as a list (`BilinearGrid.segment_scalar`).
         """
-        return self._segments_at(*self._label_tau(perigee_m, apogee_m))
+        return self.segments_at(*self._label_tau(perigee_m, apogee_m))
 
     def relocate_segments(
         self, label: ArrayLike, tau: ArrayLike, perigee_m: ArrayLike, apogee_m: ArrayLike, apogee_after_m: ArrayLike
@@ -655,16 +655,20 @@ class UniversalCurves:
         before_label, before_tau = self._label_tau(perigee_m, apogee_m)
         after_label, after_tau = self._label_tau(perigee_m, apogee_after_m)
         if isinstance(before_tau, float) and isinstance(label, float):
-            return self._segments_at(
+            return self.segments_at(
                 label + (after_label - before_label), max(float(tau) + (after_tau - before_tau), 0.0)
             )
-        return self._segments_at(
+        return self.segments_at(
             np.asarray(label, dtype=np.float64) + (after_label - before_label),
             np.maximum(np.asarray(tau, dtype=np.float64) + (after_tau - before_tau), 0.0),
         )
 
-    def _segments_at(self, label: Any, tau: Any) -> tuple[CurvePoint, Any, Any, Any]:
-        """The point (label, tau), its heights and its cell of table B (see `locate_segments`)."""
+    def segments_at(self, label: Any, tau: Any) -> tuple[CurvePoint, Any, Any, Any]:
+        """The point (label, tau), its heights and its cell of table B (see `locate_segments`).
+
+        What `locate_segments` gives for the heights table A puts at (label, tau): a start
+        replayed from its curve coordinates is the start, bit for bit.
+        """
         if isinstance(label, float) and isinstance(tau, float):
             segment, ty_s = self.table_b.segment_scalar(label, tau)
             hp_s, ha_s, q_s = _heights_along(label, segment, ty_s)

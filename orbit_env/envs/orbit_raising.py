@@ -89,6 +89,18 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``density_scale``, ``density_phase_rad`` and the satellite's
     ``drag_coefficient``, ``area_m2``, ``dry_mass_kg``, ``propellant_mass_kg``,
     ``isp_s``. A missing height is drawn; an invalid option raises ``ValueError``.
+    Instead of the heights, ``curve_label`` and ``curve_tau`` (together) pin the orbit's
+    point on the universal curves, the state's ``label`` and ``tau``.
+
+    Replaying a start: ``env.unwrapped.start_options`` is the dict of options that
+    gives the episode's start back bit for bit (``curve_label``, ``curve_tau``, the
+    density's two and the satellite's five), and ``reset(options=start_options)`` then
+    gives the same returns for the same actions. The heights the state reports do not
+    replay a start: they are table B's heights at the point table A located for the
+    drawn heights, and table A locates them up to 30 m of perigee and 0.5 km of apogee
+    away (some 0.3 day of return). The vector environment's ``start_options`` holds
+    each sub-environment's (automatic resets included) as arrays; row i restarts its
+    mission in a single environment too (returns equal to about 1e-12 day).
 
     ## Episode End
 
@@ -130,6 +142,8 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ``config={"horizon_steps": 100}``, ``density=DensityConfig(...)``); flat keywords
     then replace single fields. An unknown keyword is a ``ValueError`` that names it
     and lists the valid ones. Besides: ``continuous=False`` and ``render_mode=None``.
+    ``reset(options=...)`` takes the options of ``Starting State``
+    (`orbit_env.envs.reset_options.RESET_OPTIONS`; ``start_options`` gives a start's).
     The same keywords for ``gymnasium.make_vec(id, num_envs=N)``, the numpy-batched
     version (`orbit_env.envs.vector.OrbitRaisingVectorEnv`), which also takes
     ``autoreset_mode``.
@@ -185,6 +199,10 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         (100, False)
         >>> bool(obs[1] > 0.9)  # the apogee went from 700 km to about 1100 km
         True
+        >>> start = env.unwrapped.start_options  # replays the start bit for bit
+        >>> _ = env.reset(options=start)
+        >>> env.unwrapped.start_options == start
+        True
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 8}
@@ -211,6 +229,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         self.observation_space = self.task.observation_space
         self.action_space = self.task.action_space
         self._state: TaskState | None = None
+        self._start_options: dict[str, float] = {}
         self._track: list[tuple[float, float, float]] = []  # (perigee, apogee, burn) for render()
         self._last_burn_m_s = 0.0
         self._dv_used_m_s = 0.0  # the burns of the episode so far, for info["dv_used_m_s"]
@@ -254,6 +273,19 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         }
 
     @property
+    def start_options(self) -> dict[str, float]:
+        """The reset options that give this episode's start back bit for bit (a new dict).
+
+        ``reset(options=env.unwrapped.start_options)`` restarts the same mission: the
+        orbit's point on the universal curves (``curve_label``, ``curve_tau``), the density
+        (``density_scale``, ``density_phase_rad``) and the satellite; the same actions then
+        give the same returns. See ``Starting State``.
+        """
+        if self._state is None:
+            raise RuntimeError("the environment has no state before reset()")
+        return dict(self._start_options)
+
+    @property
     def task_state(self) -> TaskState:
         """The task model's state of the satellite (`orbit_env.envs.task.TaskState`; live, not a copy)."""
         if self._state is None:
@@ -265,7 +297,8 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
         """Start a new mission; ``options`` may pin the orbit and the satellite (see the class)."""
         super().reset(seed=seed)
-        self._state = state = task_model.start(self.task, self.np_random, None, options)
+        self._state, self._start_options = task_model.start_and_options(self.task, self.np_random, None, options)
+        state = self._state
         self._last_burn_m_s = 0.0
         self._dv_used_m_s = 0.0
         if self.render_mode is not None:

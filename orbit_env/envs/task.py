@@ -5,7 +5,8 @@ km only in the reset options (the user's edge). In the manner of gymnax's
 ``step_env(key, state, action, params)``: a frozen `Task` holds the
 parameters, a `TaskState` the mutable state, and module functions move it:
 
-* `start`: draw (or pin) new missions;
+* `start`: draw (or pin) new missions (`start_and_options`: and the reset options
+  that give them back bit for bit);
 * `step`: burn at perigee (maybe), relocate the orbit on the universal curves,
   update the drag rates, coast K revolutions, and reward;
 * `observe`: the scaled observation of a state;
@@ -59,7 +60,7 @@ from orbit_env.envs.config import (
     DensityConfig,
     OrbitRaisingConfig,
 )
-from orbit_env.envs.reset_options import resolve_options
+from orbit_env.envs.reset_options import START_OPTIONS, resolve_options
 from orbit_env.envs.rocket import delta_v_left_m_s, mass_from_delta_v_left_kg, perigee_burn
 from orbit_env.envs.spaces import UniformBox
 from orbit_env.envs.state import STALE_SEGMENT, AnyState, BatchState, TaskState
@@ -327,8 +328,22 @@ def start(
     Raises:
         ValueError: an unknown or invalid option.
     """
+    return start_and_options(task, rng, size, options)[0]
+
+
+def start_and_options(
+    task: Task, rng: np.random.Generator, size: int | None = None, options: Mapping[str, Any] | None = None
+) -> tuple[AnyState, dict[str, Any]]:
+    """`start`, and the reset options that give these missions back bit for bit.
+
+    The options (`orbit_env.envs.reset_options.START_OPTIONS`, floats, or arrays of shape
+    (size,)) pin the orbit by its point on the curves, not by its heights: a start's
+    heights are table B's at the point table A locates for the drawn heights, and
+    locating those through table A again gives another point (up to 30 m of perigee,
+    0.5 km of apogee and 0.3 day of return away).
+    """
     drawn = sample_start(rng, task.config, task.density, size)
-    values = resolve_options(options, drawn, task.config, size)
+    values = resolve_options(options, drawn, task.config, size, task.curves)
     state = _new_state(size)
     state.dry_mass_kg = values["dry_mass_kg"]
     state.mass_kg = values["dry_mass_kg"] + values["propellant_mass_kg"]
@@ -339,11 +354,25 @@ def start(
     state.time_days = state.steps = 0.0
     state.perigee_drop_m = state.apogee_drop_m = 0.0
     update_satellite(task, state)
-    perigee_m, apogee_m = values["perigee_km"] * 1e3, values["apogee_km"] * 1e3
-    if size is not None:
-        perigee_m, apogee_m = np.broadcast_to(perigee_m, (size,)), np.broadcast_to(apogee_m, (size,))
-    place(task, state, perigee_m, apogee_m)
-    return state
+    if "curve_label" in values:
+        label, tau = values["curve_label"], values["curve_tau"]
+        if size is not None:
+            label, tau = np.broadcast_to(label, (size,)), np.broadcast_to(tau, (size,))
+        _put_point(state, *task.curves.segments_at(label, tau))
+    else:
+        perigee_m, apogee_m = values["perigee_km"] * 1e3, values["apogee_km"] * 1e3
+        if size is not None:
+            perigee_m, apogee_m = np.broadcast_to(perigee_m, (size,)), np.broadcast_to(apogee_m, (size,))
+        place(task, state, perigee_m, apogee_m)
+    return state, _start_options(state, values, size)
+
+
+def _start_options(state: AnyState, values: dict[str, Any], size: int | None) -> dict[str, Any]:
+    """The `START_OPTIONS` of new missions: their point on the curves, their density and satellite."""
+    values = {**values, "curve_label": state.label, "curve_tau": state.tau}
+    if size is None:
+        return {name: float(values[name]) for name in START_OPTIONS}
+    return {name: np.array(np.broadcast_to(values[name], (size,)), dtype=np.float64) for name in START_OPTIONS}
 
 
 def _satellite_states(task: Task, dv_left_m_s: ArrayLike, steps: ArrayLike, size: int) -> BatchState:

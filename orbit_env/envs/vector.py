@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig, resolve_task_arguments
+from orbit_env.envs.reset_options import START_OPTIONS
 from orbit_env.envs.state import BatchState
 from orbit_env.envs.task import Task, TaskView
 
@@ -57,7 +58,8 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
 
     ``reset(options=...)`` takes the single environment's options, each a number
     or an array of shape (num_envs,); they pin only that reset, not the automatic
-    ones. All randomness is drawn from ``self.np_random``, one stream for the
+    ones. ``start_options`` gives back every current episode's start, automatic
+    resets included. All randomness is drawn from ``self.np_random``, one stream for the
     batch: sub-environment i is not the single environment seeded with seed + i.
 
     Version History: that of `OrbitRaisingEnv` (the same ids and dynamics),
@@ -121,6 +123,9 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         self._has_state = False
         self._pool: BatchState | None = None
         self._pool_obs = np.zeros((0, 7), dtype=np.float32)
+        # Each episode's START_OPTIONS as rows (copied with its state at a restart), and the pool's.
+        self._start_rows = np.zeros((len(START_OPTIONS), self.num_envs))
+        self._pool_start_rows = np.zeros((len(START_OPTIONS), 0))
         self._pool_next = self.num_envs
         self._last_obs = np.zeros((self.num_envs, 7), dtype=np.float32)  # for reset_mask
         self._everyone_mask = np.ones(self.num_envs, dtype=np.bool_)  # info["_burn_m_s"], read-only
@@ -136,6 +141,19 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             name: getattr(s, name).copy()
             for name in ("label", "tau", "perigee_m", "apogee_m", "mass_kg", "time_days", "density_scale")
         }
+
+    @property
+    def start_options(self) -> dict[str, FloatArray]:
+        """The reset options that give every current episode's start back bit for bit (arrays of shape (num_envs,)).
+
+        As `OrbitRaisingEnv.start_options`, for the episode each sub-environment is in,
+        whether ``reset`` or an automatic reset began it: ``reset(options=env.start_options)``
+        restarts all of them, and row i's values (``{k: v[i] for k, v in ...items()}``) restart
+        sub-environment i's mission in a single environment.
+        """
+        if not self._has_state:
+            raise RuntimeError("the environment has no state before reset()")
+        return {name: row.copy() for name, row in zip(START_OPTIONS, self._start_rows, strict=True)}
 
     @property
     def task_state(self) -> BatchState:
@@ -167,8 +185,9 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         if mask is not None and not options:
             obs[idx] = self._restart(idx)  # fresh draws, as an automatic reset's
         else:
-            fresh = task_model.start(self.task, self.np_random, idx.size, options or None)
+            fresh, start_options = task_model.start_and_options(self.task, self.np_random, idx.size, options or None)
             self._state.put(idx, fresh)
+            self._start_rows[:, idx] = [start_options[name] for name in START_OPTIONS]
             self._dv_used_m_s[idx] = 0.0
             obs[idx] = task_model.observe(self.task, fresh)
         self._has_state = True
@@ -261,11 +280,13 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         time into a pool (with the same function as ``reset``) and handed out in order.
         """
         if self._pool is None or self._pool_next + idx.size > self.num_envs:
-            self._pool = task_model.start(self.task, self.np_random, self.num_envs)
+            self._pool, start_options = task_model.start_and_options(self.task, self.np_random, self.num_envs)
+            self._pool_start_rows = np.array([start_options[name] for name in START_OPTIONS])
             self._pool_obs = task_model.observe(self.task, self._pool)
             self._pool_next = 0
         take = slice(self._pool_next, self._pool_next + idx.size)
         self._pool_next += idx.size
         self._state.put(idx, self._pool.data[:, take])
+        self._start_rows[:, idx] = self._pool_start_rows[:, take]
         self._dv_used_m_s[idx] = 0.0
         return self._pool_obs[take]
