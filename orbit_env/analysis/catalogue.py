@@ -69,7 +69,6 @@ from orbit_env.analysis.lifetime import (
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import InputError, check_number
-from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.decay.chunked import (
     RATIO_NODES,
@@ -82,7 +81,7 @@ from orbit_env.decay.chunked import (
     life_rate_ratio,
     orbit_ratio,
 )
-from orbit_env.decay.curves import NU_REF, UniversalCurves
+from orbit_env.decay.curves import NU_REF, UniversalCurves, days_from_weighted_s
 
 FloatArray = NDArray[np.float64]
 
@@ -552,7 +551,7 @@ def _spread_days(
         ratio = ratio * corotation_factor(hp, ha, np.asarray(inclination_deg, dtype=np.float64)[:, None], reference_deg)
     inverse = 1.0 / ratio
     time_gcs = np.sum(np.diff(weighted, axis=1) * 0.5 * (inverse[:, 1:] + inverse[:, :-1]), axis=1)
-    return np.asarray(time_gcs / (G0_M_S2 * drag_parameter_m2_kg * scenario.density_scale) / SECONDS_PER_DAY)
+    return days_from_weighted_s(time_gcs, drag_parameter_m2_kg, scenario.density_scale)
 
 
 def _life_rate_ratio(

@@ -25,7 +25,7 @@ from orbit_env.decay.curves import (
     CURVES_MAX_PERIGEE_M,
     NU_REF,
     UniversalCurves,
-    nu_per_revolution,
+    days_from_weighted_s,
     universal_curves,
 )
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
@@ -312,7 +312,7 @@ def lifetime(
     rotating = scenario.corotating
     model = DecayModel(atmosphere, rotating_atmosphere=rotating, inclination_deg=inclination_deg)
     per_nu = satellite.revolutions_per_nu
-    to_days = 1.0 / (float(nu_per_revolution(satellite.drag_parameter_m2_kg)) * SECONDS_PER_DAY)
+    c = satellite.drag_parameter_m2_kg
     if method == "direct":
         from orbit_env.decay.direct import integrate_direct
 
@@ -350,23 +350,23 @@ def lifetime(
         weighted_left = np.concatenate([[weighted], (mean_period * nu_left)[1:]])
         history = DecayHistory(
             revolutions=(nu - nu_left) * per_nu,
-            days=(weighted - weighted_left) * to_days,
+            days=days_from_weighted_s(weighted - weighted_left, c),
             perigee_km=np.concatenate([[hp_m], hp_path[1:]]) / 1e3,
             apogee_km=np.concatenate([[ha_m], ha_path[1:]]) / 1e3,
             nu_remaining=nu_left,
         )
-        revolutions, days = nu * per_nu, weighted * to_days
+        revolutions, days = nu * per_nu, float(days_from_weighted_s(weighted, c))
     else:
         path = integrate_averaged(hp_m, ha_m, model)
         nu, weighted = float(path.nu[-1]), float(path.weighted_s[-1])
         history = DecayHistory(
             revolutions=path.nu * per_nu,
-            days=path.weighted_s * to_days,
+            days=days_from_weighted_s(path.weighted_s, c),
             perigee_km=path.perigee_m / 1e3,
             apogee_km=path.apogee_m / 1e3,
             nu_remaining=nu - path.nu,
         )
-        revolutions, days = nu * per_nu, weighted * to_days
+        revolutions, days = nu * per_nu, float(days_from_weighted_s(weighted, c))
     return LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, check_lifetime_days(days), method, history)
 
 
@@ -459,7 +459,7 @@ def _lifetime_under_activity(
         method = "averaged"
         mean = mean_air_lifetime(hp_m, ha_m, c * scale, model)
         days, reentered = mean.days, mean.reentered
-        t = mean.trajectory.weighted_s / (G0_M_S2 * c * scale) / SECONDS_PER_DAY
+        t = days_from_weighted_s(mean.trajectory.weighted_s, c, scale)
         inside = t < days
         t = np.append(t[inside], days)
         hp_path = np.append(mean.trajectory.perigee_m[inside], mean.trajectory.perigee_m[-1])
@@ -561,13 +561,13 @@ def _mean_air_lifetimes(scenario: Scenario, c: float, inclination_deg: float, hp
 def _averaged_lifetimes(scenario: Scenario, c: float, inclination_deg: float) -> Any:
     """The rule's lifetime function on the averaged equations (fixed profile; any heights)."""
     model = scenario.decay_model(inclination_deg)
-    rate = G0_M_S2 * c * scenario.density_scale
 
     def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
         days = np.zeros(hp.size)
         for i, (perigee, apogee) in enumerate(zip(hp.tolist(), ha.tolist(), strict=True)):
             if perigee > REENTRY_ALTITUDE_M:
-                days[i] = float(integrate_averaged(perigee, apogee, model).weighted_s[-1]) / rate / SECONDS_PER_DAY
+                weighted = integrate_averaged(perigee, apogee, model).weighted_s[-1]
+                days[i] = float(days_from_weighted_s(weighted, c, scenario.density_scale))
         return days, np.ones(hp.size, dtype=bool)
 
     return lifetimes

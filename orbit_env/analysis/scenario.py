@@ -14,10 +14,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.analysis.air import Air, PaperAir
 from orbit_env.checks import check_number
-from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, propagate
-from orbit_env.decay.curves import UniversalCurves
+from orbit_env.decay.curves import UniversalCurves, days_from_weighted_s
 from orbit_env.decay.solar import SolarActivity, iso_date
 from orbit_env.physics.atmosphere import Atmosphere
 from orbit_env.physics.atmosphere.paper import RHO100_CALIBRATED_KG_M3
@@ -180,7 +180,7 @@ class Scenario:
             if own_inclination_deg is not None:
                 raise ValueError("own_inclination_deg applies to the time-stepped path only")
             point = self.curves(inclination_deg).locate(hp, ha)
-            days = np.asarray(point.weighted_s / (G0_M_S2 * c * s) / SECONDS_PER_DAY, dtype=np.float64)
+            days = days_from_weighted_s(point.weighted_s, c, s)
             return days, np.ones(days.shape, dtype=bool)
         model = self.solar_model(
             inclination_deg, None if max_days is None else max(max_days / 365.25, self.chunk_days / 365.25)

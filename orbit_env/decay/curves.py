@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from orbit_env import cache
 from orbit_env.checks import check_array
-from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M
+from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.physics.orbit import period_s, validate_heights, validate_heights_km
 
@@ -797,6 +797,21 @@ def nu_per_revolution(drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike 
     if isinstance(drag_parameter_m2_kg, float) and isinstance(density_scale, float):
         return G0_M_S2 * drag_parameter_m2_kg * density_scale
     return G0_M_S2 * np.multiply(drag_parameter_m2_kg, density_scale, dtype=np.float64)
+
+
+def days_from_weighted_s(
+    weighted_s: ArrayLike, drag_parameter_m2_kg: ArrayLike, density_scale: ArrayLike = 1.0
+) -> FloatArray:
+    """Days of a decay from its weighted time W = Int P dnu [s m^3/(kg s^2)]: W / (g c s) / 86400 (Eq. 4.1).
+
+    The one conversion of the universal variable's time into days; W comes from the
+    curves (``weighted_s``) or the averaged equations.
+    """
+    return np.asarray(
+        np.asarray(weighted_s, dtype=np.float64)
+        / (G0_M_S2 * np.multiply(drag_parameter_m2_kg, density_scale, dtype=np.float64))
+        / SECONDS_PER_DAY
+    )
 
 
 def universal_curves(model: DecayModel | None = None) -> UniversalCurves:

@@ -30,9 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel, Trajectory, integrate_averaged
 from orbit_env.decay.chunked import SolarDecayModel
+from orbit_env.decay.curves import days_from_weighted_s
 from orbit_env.physics.atmosphere.msis import interpolate_log_density
 
 FloatArray = NDArray[np.float64]
@@ -89,7 +90,7 @@ class MeanAirLifetime:
 
 
 def _days(trajectory: Trajectory, drag_parameter_m2_kg: float) -> float:
-    return float(trajectory.weighted_s[-1]) / (G0_M_S2 * drag_parameter_m2_kg) / SECONDS_PER_DAY
+    return float(days_from_weighted_s(trajectory.weighted_s[-1], drag_parameter_m2_kg))
 
 
 def mean_air_model(model: SolarDecayModel, atmosphere: MeanProfileAtmosphere) -> DecayModel:
