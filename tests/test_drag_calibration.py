@@ -189,12 +189,9 @@ def test_real_reentries_from_element_sets_meet_the_goals():
     # one set median |error| 14.2%, history 10.3% with 90.6% of cases within +-25%, band coverage 91.5% and
     # 90.6%. Held to issue 27's goals where they were met (one set median <= 20%, history 90% within
     # +-25%, the 90% band holding >= 85%) and, for the history's median (goal 10%), to 12%.
-    import importlib.util
+    import benchmark_scripts
 
-    path = DATA.parent.parent / "validate_element_sets.py"
-    spec = importlib.util.spec_from_file_location("validate_element_sets", path)
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+    script = benchmark_scripts.load("validate_element_sets")
     objects = [o for o in script.load_objects() if not o.flagged]
     cases = script.run_cases(objects, history=True, samples=200, limit=None)
     summary = script.summarize(cases)

@@ -13,29 +13,18 @@ and doubling its points per revolution moved the life by 0.007%, measured once).
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import sys
-from pathlib import Path
 
+import benchmark_scripts
 import pytest
 
 pytest.importorskip("pymsis")
 
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
-
 
 @pytest.fixture(scope="module")
 def geometry():
-    sys.path.insert(0, str(BENCHMARKS))  # the check imports its sibling validate_reentries
-    try:
-        spec = importlib.util.spec_from_file_location("validate_geometry", BENCHMARKS / "validate_geometry.py")
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[spec.name] = module
-        spec.loader.exec_module(module)
-        yield module
-    finally:
-        sys.path.remove(str(BENCHMARKS))
+    return benchmark_scripts.load("validate_geometry")  # it imports its sibling validate_reentries
 
 
 def test_sidereal_angle_and_sun_at_the_start_of_2000(geometry):

@@ -19,25 +19,17 @@ re-entry date minus the start (benchmarks/reentry_cases.csv), never the code's o
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
-from pathlib import Path
 
+import benchmark_scripts
 import pytest
 
 pytest.importorskip("pymsis")
 
-SCRIPT = Path(__file__).resolve().parent.parent / "benchmarks" / "validate_reentries.py"
-
 
 @pytest.fixture(scope="module")
 def validation():
-    spec = importlib.util.spec_from_file_location("validate_reentries", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look the module up by name
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_scripts.load("validate_reentries")
 
 
 #: Within +-25% of the observed life unless listed: the known misses, each with its ceiling (measured miss).

@@ -6,23 +6,15 @@ No prediction is run here (a case costs seconds to a minute); the script's own r
 from __future__ import annotations
 
 import datetime as dt
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
+import benchmark_scripts
 import pytest
-
-SCRIPT = Path(__file__).resolve().parent.parent / "benchmarks" / "validate_element_sets.py"
 
 
 @pytest.fixture(scope="module")
 def v():
-    spec = importlib.util.spec_from_file_location("validate_element_sets", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look the module up by name
-    spec.loader.exec_module(module)
-    return module
+    return benchmark_scripts.load("validate_element_sets")
 
 
 def test_selection_takes_latest_quarter_and_earliest_inside_the_window(v):
