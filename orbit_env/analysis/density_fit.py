@@ -274,14 +274,11 @@ def fit_density_scale(
                 float(hp[0]), float(ha[0]), dt_days, c, scenario, inclination_deg, reentry_sigma_days, height_sigma_km
             )
         )
-    if scenario.time_varying:
-        raise ValueError(
-            "fitting observed orbits needs a fixed profile (no --epoch, --solar-csv or --solar-cycle); "
-            "with changing activity give the re-entry date (--reentry)"
-        )
     n = hp.size
     if n < 3:
         raise ValueError(f"an orbit fit needs at least 3 observations, got {n} (or give --reentry)")
+    if scenario.time_varying:
+        return _plausible(_fit_orbits_time_varying(observations, hp, ha, c, scenario, inclination_deg))
     curves = scenario.curves(inclination_deg)
     gc_dt = G0_M_S2 * c * scenario.density_scale * (observations.days - observations.days[0]) * SECONDS_PER_DAY
     observed = np.concatenate([hp, ha]) / 1e3
@@ -316,6 +313,87 @@ def fit_density_scale(
             f"({observations.source})",
             residual_rms_km=float(math.sqrt(float(residuals @ residuals) / residuals.size)),
         )
+    )
+
+
+#: ln s of the time-varying orbit fit's first grid (0.05 to 20, as the re-entry fit's bracket).
+_LOG_SCALE_GRID = np.linspace(math.log(0.05), math.log(20.0), 41)
+
+
+def _fit_orbits_time_varying(
+    observations: Observations, hp: FloatArray, ha: FloatArray, c: float, scenario: Scenario, inclination_deg: float
+) -> DensityFit:
+    """The orbit fit under changing activity: s on a grid, every candidate propagated at once from the first orbit.
+
+    The air follows the record from the first observation's date, which must be the
+    scenario's epoch (one date convention). Each candidate s is a satellite of its own in
+    one vectorized propagation, stepped a day at a time; its heights at the observed times
+    give the sum of squared height residuals, whose minimum over a grid refined twice is
+    the fit; sigma of ln s from the parabola through the minimum and its neighbours, with
+    the noise estimated from the residuals (2n - 1 degrees of freedom). The first orbit's
+    heights are held as observed (the fixed-profile fit also fits them).
+    """
+    from dataclasses import replace
+
+    from orbit_env.decay.chunked import propagate
+
+    if observations.axis != "date":
+        raise ValueError(
+            "under the real Sun the observations need dates (a 'date' column), so the air is that of their days"
+        )
+    start = float(observations.days[0])
+    if scenario.epoch_days is None or abs(scenario.epoch_days - start) > 1e-6:
+        raise ValueError(
+            f"the air starts on {scenario.epoch_days} (unix days) but the first observation is on {start}: "
+            "fit from the first observation's date (give no --epoch, or that date)"
+        )
+    t = observations.days - start
+    model = replace(scenario.solar_model(inclination_deg, max_years=float(t[-1]) / 365.25 + 0.1), chunk_days=1.0)
+    observed = np.concatenate([hp, ha])
+
+    def rss(log_scales: FloatArray) -> FloatArray:
+        k = log_scales.size
+        result = propagate(
+            np.full(k, hp[0]),
+            np.full(k, ha[0]),
+            c,
+            model,
+            density_scale=np.exp(log_scales) * scenario.density_scale,
+            record=True,
+        )
+        # Heights at the observed times; a candidate re-entered before an observation sits at re-entry.
+        days = result.history_days
+        model_hp = np.stack([np.interp(t, days, result.history_perigee_m[:, j]) for j in range(k)])
+        model_ha = np.stack([np.interp(t, days, result.history_apogee_m[:, j]) for j in range(k)])
+        residual = np.concatenate([model_hp, model_ha], axis=1) - observed[None, :]
+        return np.sum(residual**2, axis=1)
+
+    grid = _LOG_SCALE_GRID
+    for _ in range(3):
+        values = rss(grid)
+        best = int(np.argmin(values))
+        low, high = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
+        if best in (0, grid.size - 1):
+            break
+        grid = np.linspace(low, high, 9)
+    values = rss(grid)
+    best = int(np.clip(np.argmin(values), 1, grid.size - 2))
+    x0, x1 = grid[best - 1 : best + 1]
+    y0, y1, y2 = values[best - 1 : best + 2]
+    h = x1 - x0
+    curvature = (y0 - 2.0 * y1 + y2) / h**2
+    shift = 0.5 * h * (y0 - y2) / (y0 - 2.0 * y1 + y2) if curvature > 0 else 0.0
+    log_s = float(x1 + shift)
+    dof = 2 * hp.size - 1
+    rss_min = float(y1 - (y0 - y2) ** 2 / (8.0 * (y0 - 2.0 * y1 + y2)) if curvature > 0 else y1)
+    sigma2 = max(rss_min, 0.0) / dof
+    sigma_log = math.sqrt(2.0 * sigma2 / curvature) if curvature > 0 else math.inf
+    return DensityFit(
+        scale=math.exp(log_s),
+        sigma_log=sigma_log,
+        dof=dof,
+        description=f"{hp.size} orbits over {t[-1]:.4g} days under the record's Sun ({observations.source})",
+        residual_rms_km=math.sqrt(max(rss_min, 0.0) / (2 * hp.size)) / 1e3,
     )
 
 

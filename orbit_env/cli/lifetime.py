@@ -14,6 +14,8 @@ import sys
 import time
 from typing import Any
 
+import numpy as np
+
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.air.msis import MSIS_VERSION_CHOICES
 from orbit_env.analysis.lifetime import (
@@ -255,11 +257,18 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     _check_inclination(args)
     if args.inclination is None:
         args.inclination = 0.0
+    observations = read_observations(args.observations)
+    solar_given = any(given(args, name) for name in ("f107", "f107a", "ap", "solar_csv", "solar_cycle"))
+    if observations.axis == "date" and args.epoch is None and not solar_given:
+        # Dated observations: the air of their days, the real Sun from the first (as a TLE's epoch does).
+        if args.atmosphere is None:
+            args.atmosphere = DATED_AIR
+        if "epoch" in air_model(args.atmosphere).options:
+            args.epoch = str(np.datetime64(round(float(observations.days[0]) * 86400.0), "s"))
     if args.atmosphere is None:
         args.atmosphere = DATED_AIR if args.epoch is not None else DEFAULT_AIR
     satellite = _satellite(args)
     scenario = _scenario(args)
-    observations = read_observations(args.observations)
     reentry = None if args.reentry is None else reentry_days(args.reentry, observations, "--reentry")
     fit = fit_density_scale(
         observations,
