@@ -134,12 +134,20 @@ def test_fit_density_reentry_on_the_observations_axis(capsys, tmp_path):
     in_days.write_text("days,perigee_km,apogee_km\n10,300,320\n")
     dated = tmp_path / "dated.csv"
     dated.write_text("date,perigee_km,apogee_km\n2020-09-01,300,320\n")
-    # The same decay, 31 days from the first orbit to re-entry, on either axis: the same scale.
-    status, out_days, _ = run(capsys, "fit-density", in_days, "--reentry", "41", "--json")
+    # The same decay, 31 days from the first orbit to re-entry, on either axis and in the same
+    # (undated) air: the same scale, to the last bits (one fit, only the axis differs).
+    status, out_days, _ = run(capsys, "fit-density", in_days, "--reentry", "41", "--json", "--atmosphere", "paper")
     assert status == 0
-    status, out_dated, _ = run(capsys, "fit-density", dated, "--reentry", "2020-10-02", "--json")
+    status, out_dated, _ = run(
+        capsys, "fit-density", dated, "--reentry", "2020-10-02", "--json", "--atmosphere", "paper"
+    )
     assert status == 0
     assert json.loads(out_days)["scale"] == pytest.approx(json.loads(out_dated)["scale"], rel=1e-12)
+    # Left to the defaults, dates select NRLMSIS under the shipped record (days: the paper's air).
+    status, out_dated, _ = run(capsys, "fit-density", dated, "--reentry", "2020-10-02", "--json")
+    assert status == 0
+    assert json.loads(out_dated)["atmosphere"].startswith("NRLMSIS 2.1, CelesTrak space weather")
+    assert json.loads(out_days)["atmosphere"].startswith("paper")
     # Mixed axes: refused, naming both.
     status, _, err = run(capsys, "fit-density", in_days, "--reentry", "2020-10-02")
     assert status == 2 and err == (
