@@ -38,6 +38,7 @@ from orbit_env.constants import (
 )
 from orbit_env.decay.averaged import DecayModel, kernel_rates
 from orbit_env.decay.curves import NU_REF, UniversalCurves
+from orbit_env.decay.daily_air import DailyAirTable, daily_air_table
 from orbit_env.decay.solar import SolarActivity, day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
@@ -45,12 +46,9 @@ from orbit_env.physics.atmosphere.msis import (
     DEFAULT_MSIS_VERSION,
     SEASON_NODES,
     MsisAtmosphere,
-    _msis_density,
     check_msis_version,
     interpolate_log_density,
     mean_density_kg_m3,
-    mean_density_over_days_kg_m3,
-    orbit_samples,
 )
 from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
@@ -101,6 +99,10 @@ RATIO_NODES = {"latitude_nodes": 6, "local_time_nodes": 6}
 #: row in a co-rotating spread catalogue, stay in the cache instead of fresh pages of 100 MB).
 RATE_BLOCK_ROWS = 1000
 
+#: Days [d] whose air is computed together when a chunk meets a day the air table does not hold yet
+#: (`orbit_env.decay.daily_air`): one NRLMSIS call of half a year instead of one per chunk.
+PREFETCH_DAYS = 180
+
 DailyIndices = tuple[tuple[float, float, float, float], ...]
 
 
@@ -119,6 +121,18 @@ def bin_indices(f107a_sfu: float, ap: float, bin_step: float) -> tuple[float, fl
     return round(f_bin, 6), ap_bin
 
 
+def air_table(inclination_deg: float, ascending_node_local_time_h: float | None, version: float) -> DailyAirTable:
+    """The days' orbit-averaged NRLMSIS densities on `RATIO_GRID_M` at `RATIO_NODES` (`orbit_env.decay.daily_air`)."""
+    return daily_air_table(
+        tuple(RATIO_GRID_M.tolist()),
+        float(inclination_deg),
+        ascending_node_local_time_h,
+        version,
+        RATIO_NODES["latitude_nodes"],
+        RATIO_NODES["local_time_nodes"],
+    )
+
+
 @lru_cache(maxsize=4096)
 def _log_ratio(
     daily: DailyIndices,
@@ -127,19 +141,10 @@ def _log_ratio(
     ascending_node_local_time_h: float | None,
     version: float,
 ) -> FloatArray:
-    f107, f107a, ap, doy = (np.array(column) for column in zip(*daily, strict=True))
-    rho_exact = mean_density_over_days_kg_m3(
-        RATIO_GRID_M,
-        f107,
-        f107a,
-        ap,
-        doy,
-        inclination_deg,
-        ascending_node_local_time_h,
-        **RATIO_NODES,
-        version=version,
+    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily)
+    return np.log(np.exp(log_rho).mean(axis=0)) - _log_bin_density(
+        binned, inclination_deg, ascending_node_local_time_h, version
     )
-    return np.log(rho_exact) - _log_bin_density(binned, inclination_deg, ascending_node_local_time_h, version)
 
 
 @lru_cache(maxsize=1024)
@@ -151,11 +156,9 @@ def _log_ratios_by_day(
     ascending_node_local_time_h: float | None,
     version: float,
 ) -> FloatArray:
-    """`_log_ratio` of each day of ``daily`` (``per_day`` rows each), in one NRLMSIS call: shape (days, heights)."""
-    f107, f107a, ap, doy = (np.array(column) for column in zip(*daily, strict=True))
-    lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, **RATIO_NODES)
-    rho = _msis_density(RATIO_GRID_M, lat[None, :], local_time[None, :], doy - 1.0, f107, f107a, ap, version)[0]
-    rho_days = rho.reshape(-1, per_day, *rho.shape[1:]).mean(axis=(1, 2))
+    """`_log_ratio` of each day of ``daily`` (``per_day`` rows each): shape (days, heights)."""
+    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily)
+    rho_days = np.exp(log_rho).reshape(-1, per_day, log_rho.shape[1]).mean(axis=1)
     bin_log_rho = _log_bin_density(binned, inclination_deg, ascending_node_local_time_h, version)
     return np.log(rho_days) - bin_log_rho[None, :]
 
@@ -164,18 +167,11 @@ def _log_ratios_by_day(
 def _log_bin_density(
     binned: tuple[float, float], inclination_deg: float, ascending_node_local_time_h: float | None, version: float
 ) -> FloatArray:
-    rho = mean_density_kg_m3(
-        RATIO_GRID_M,
-        binned[0],
-        binned[0],
-        binned[1],
-        inclination_deg,
-        None,
-        ascending_node_local_time_h,
-        **RATIO_NODES,
-        version=version,
-    )
-    return np.log(rho)
+    """Ln of a bin's density on `RATIO_GRID_M`: its indices on `SEASON_NODES` days spread over the year, averaged."""
+    season = (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
+    keys = [(binned[0], binned[0], binned[1], float(doy)) for doy in season]
+    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(keys)
+    return np.log(np.exp(log_rho).mean(axis=0))
 
 
 @lru_cache(maxsize=256)
@@ -369,6 +365,7 @@ class SolarDecayModel:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""
         days = self.chunk_samples(t_days)
         daily = self.daily_indices(days)
+        self.prefetch(daily, t_days)
         _, f107a, ap = self.activity.indices(days)
         return daily, bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step)
 
@@ -400,6 +397,13 @@ class SolarDecayModel:
             columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(nodes, days.size))
         return tuple(zip(*(c.tolist() for c in columns), strict=True))
 
+    def prefetch(self, daily: DailyIndices, t_days: float) -> None:
+        """Make sure the air table holds ``daily``; if not, it also computes the `PREFETCH_DAYS` from ``t_days``."""
+        table = air_table(self.inclination_deg, self.ascending_node_local_time_h, self.version)
+        table.log_density(
+            daily, ahead=lambda: self.daily_indices(self.start_days + t_days + np.arange(PREFETCH_DAYS, dtype=float))
+        )
+
     def log_ratios_by_day(self, first_day: int, count: int, binned: tuple[float, float]) -> FloatArray:
         """`log_ratio` of each of ``count`` days from ``first_day`` (days after the start), shape (days, heights).
 
@@ -407,8 +411,10 @@ class SolarDecayModel:
         """
         days = self.start_days + first_day + np.arange(count, dtype=np.float64)
         per_day = 1 if self.follow_season else SEASON_NODES
+        daily = self.daily_indices(days)
+        self.prefetch(daily, float(first_day))
         return _log_ratios_by_day(
-            self.daily_indices(days),
+            daily,
             per_day,
             binned,
             float(self.inclination_deg),

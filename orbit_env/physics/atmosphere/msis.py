@@ -272,11 +272,71 @@ def mean_density_over_days_kg_m3(
     of densities, not the density of mean indices: NRLMSIS responds to Ap
     concavely, so averaging the indices would overstate the density after storms.
     """
+    rho = _orbit_samples_density(
+        altitude_m,
+        f107_sfu,
+        f107a_sfu,
+        ap,
+        day_of_year,
+        inclination_deg,
+        ascending_node_local_time_h,
+        latitude_nodes,
+        local_time_nodes,
+        version,
+    )
+    return rho.mean(axis=(0, 1))
+
+
+def orbit_mean_density_by_day_kg_m3(
+    altitude_m: ArrayLike,
+    f107_sfu: ArrayLike,
+    f107a_sfu: ArrayLike,
+    ap: ArrayLike,
+    day_of_year: ArrayLike,
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None = None,
+    *,
+    latitude_nodes: int = LATITUDE_NODES,
+    local_time_nodes: int = LOCAL_TIME_NODES,
+    version: float = DEFAULT_MSIS_VERSION,
+) -> FloatArray:
+    """Each day's orbit-averaged NRLMSIS density [kg/m^3], shape (days, altitudes), in one NRLMSIS call.
+
+    The arguments are `mean_density_over_days_kg_m3`'s, which is the mean of these rows (up to
+    the order of the sums).
+    """
+    rho = _orbit_samples_density(
+        altitude_m,
+        f107_sfu,
+        f107a_sfu,
+        ap,
+        day_of_year,
+        inclination_deg,
+        ascending_node_local_time_h,
+        latitude_nodes,
+        local_time_nodes,
+        version,
+    )
+    return rho.mean(axis=1)
+
+
+def _orbit_samples_density(
+    altitude_m: ArrayLike,
+    f107_sfu: ArrayLike,
+    f107a_sfu: ArrayLike,
+    ap: ArrayLike,
+    day_of_year: ArrayLike,
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None,
+    latitude_nodes: int,
+    local_time_nodes: int,
+    version: float,
+) -> FloatArray:
+    """NRLMSIS at an orbit's samples on each day: shape (days, samples, altitudes)."""
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
     days = np.atleast_1d(np.asarray(day_of_year, dtype=np.float64)) - 1.0
-    rho = _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap, version)
-    return rho[0].mean(axis=(0, 1))
+    return _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap, version)[0]
 
 
 def mean_density_over_inclinations_kg_m3(

@@ -1,0 +1,137 @@
+"""The real Sun's air as a table: each day's orbit-averaged NRLMSIS density, computed once and kept on disk.
+
+A decay under changing activity (`orbit_env.decay.chunked`) needs, for every day it
+crosses, NRLMSIS averaged over the orbit's latitudes and local times at that day's
+indices (F10.7, its 81-day mean, Ap, the day of the year), on the heights of
+`orbit_env.decay.chunked.RATIO_GRID_M`. Those rows depend on the day's indices, the
+inclination, the Sun-synchronous node (if any) and the NRLMSIS version, never on the
+satellite: a `DailyAirTable` holds them per (inclination, node, version), keyed by the
+indices as the decay rounds them (0.1 sfu, 0.1 Ap, the day of the year to 2 days), so
+the same row serves every satellite, every date with the same indices, the shipped
+record, an imported table and the uncertainty's scaled forecasts alike.
+
+A row is computed the first time it is asked for, together with the rows of the days
+ahead the caller names (a year, one NRLMSIS call: about 0.6 s at 6 x 6 orbit samples and 23
+heights), and the table is written to the disk cache (`orbit_env.cache`, kind
+``"airdays"``) whenever it grew: a later run, in any process, reads it in milliseconds
+and calls NRLMSIS only for days it has never seen. The rows are NRLMSIS's own values for
+those indices (a memo, not an interpolation), so results do not change with what is
+cached. Units: SI (m, kg/m^3).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from orbit_env import cache
+from orbit_env.physics.atmosphere.msis import orbit_mean_density_by_day_kg_m3
+
+FloatArray = NDArray[np.float64]
+#: A day's indices as the decay rounds them: (F10.7 [sfu], 81-day mean [sfu], Ap, day of the year 1-366).
+DayKey = tuple[float, float, float, float]
+
+
+class DailyAirTable:
+    """ln of the orbit-averaged NRLMSIS density [kg/m^3] per day's indices, on fixed heights (grown on demand).
+
+    Args:
+        heights_m: Heights above the package's 6371 km sphere (the table's columns).
+        inclination_deg: The orbit's inclination (its latitudes).
+        ascending_node_local_time_h: Sun-synchronous orbits: the node's local time (None: local
+            times uniform).
+        version: NRLMSIS version (`orbit_env.physics.atmosphere.msis.MSIS_VERSIONS`).
+        latitude_nodes: Latitude samples of the orbit average.
+        local_time_nodes: Local-time samples of the orbit average.
+    """
+
+    def __init__(
+        self,
+        heights_m: FloatArray,
+        inclination_deg: float,
+        ascending_node_local_time_h: float | None,
+        version: float,
+        latitude_nodes: int,
+        local_time_nodes: int,
+    ) -> None:
+        self.heights_m = np.asarray(heights_m, dtype=np.float64)
+        self.inclination_deg = float(inclination_deg)
+        self.ascending_node_local_time_h = ascending_node_local_time_h
+        self.version = float(version)
+        self.latitude_nodes, self.local_time_nodes = latitude_nodes, local_time_nodes
+        self._description = cache.describe(
+            (
+                tuple(self.heights_m.tolist()),
+                self.inclination_deg,
+                ascending_node_local_time_h,
+                self.version,
+                latitude_nodes,
+                local_time_nodes,
+            )
+        )
+        stored = cache.load("airdays", self._description)
+        if stored is None:
+            self._keys = np.empty((0, 4))
+            self._log_rho = np.empty((0, self.heights_m.size))
+        else:
+            self._keys, self._log_rho = stored["keys"], stored["log_density"]
+        self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(tuple, self._keys.tolist()))}
+
+    def __len__(self) -> int:
+        """The number of days' indices held."""
+        return len(self._row_of)
+
+    def log_density(self, keys: Sequence[DayKey], ahead: Callable[[], Sequence[DayKey]] | None = None) -> FloatArray:
+        """The rows of ``keys``, shape (len(keys), heights): ln(density [kg/m^3]).
+
+        Rows not held yet are computed in one NRLMSIS call with those of ``ahead()`` (the
+        days the caller will want next), and the table is written to the disk cache.
+        """
+        rows = [self._row_of.get(key) for key in keys]
+        if None in rows:
+            wanted = [key for key, row in zip(keys, rows, strict=True) if row is None]
+            if ahead is not None:
+                wanted += list(ahead())
+            self._add(wanted)
+            rows = [self._row_of[key] for key in keys]
+        return self._log_rho[rows]
+
+    def _add(self, keys: Sequence[DayKey]) -> None:
+        new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
+        f107, f107a, ap, doy = np.array(new, dtype=np.float64).T
+        rho = orbit_mean_density_by_day_kg_m3(
+            self.heights_m,
+            f107,
+            f107a,
+            ap,
+            doy,
+            self.inclination_deg,
+            self.ascending_node_local_time_h,
+            latitude_nodes=self.latitude_nodes,
+            local_time_nodes=self.local_time_nodes,
+            version=self.version,
+        )
+        start = len(self._row_of)
+        self._keys = np.concatenate([self._keys, np.array(new, dtype=np.float64)])
+        self._log_rho = np.concatenate([self._log_rho, np.log(rho)])
+        self._row_of.update({key: start + k for k, key in enumerate(new)})
+        # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
+        cache.store("airdays", self._description, {"keys": self._keys, "log_density": self._log_rho}, compress=False)
+
+
+@lru_cache(maxsize=64)
+def daily_air_table(
+    heights_m: tuple[float, ...],
+    inclination_deg: float,
+    ascending_node_local_time_h: float | None,
+    version: float,
+    latitude_nodes: int,
+    local_time_nodes: int,
+) -> DailyAirTable:
+    """The process's one `DailyAirTable` of these settings (read from the disk cache the first time)."""
+    return DailyAirTable(
+        np.array(heights_m), inclination_deg, ascending_node_local_time_h, version, latitude_nodes, local_time_nodes
+    )
