@@ -8,6 +8,11 @@ day), for the cases whose name contains a WORD (all by default; a few minutes).
 ``python benchmarks/measure_chunking.py short`` prints instead the short lives (10-40
 days) under the shipped record, in seven storms and five quiet spells, on circular
 orbits and orbits 20 km and 120 km wide: 108 cases, about six minutes. Needs pymsis.
+
+``python benchmarks/measure_chunking.py near-circular`` prints the near-circular orbits'
+coarser bins (`orbit_env.decay.chunked.NEAR_CIRCULAR_BIN_STEP`) against the fine bins,
+3U cubesats under the shipped record from seven dates over two solar cycles, circular and
+20 km wide, lives of 2 months to 19 years (co-rotating air, 51.6 deg): 35 cases.
 """
 
 import sys
@@ -83,10 +88,45 @@ def short_lives() -> None:
         )
 
 
+def near_circular() -> None:
+    """Lifetimes on the near-circular bins against the fine bins (`SolarDecayModel.near_circular_bins`)."""
+    from orbit_env.decay.solar_record import load_record
+
+    record = load_record()
+    dates = ["2001-01-01", "2005-06-01", "2008-01-01", "2012-01-01", "2015-01-01", "2019-01-01", "2024-01-01"]
+    orbits = [(350e3, 350e3), (550e3, 550e3), (440e3, 460e3), (530e3, 550e3), (480e3, 500e3)]
+    errors, bins = [], np.zeros(2, dtype=int)
+    print(f"{'start':10} {'orbit km':>9} {'fine d':>9} {'bins':>4} {'near-circular d':>15} {'bins':>4} {'change':>8}")
+    for date in dates:
+        for hp, ha in orbits:
+            runs = []
+            for coarse in (False, True):
+                model = SolarDecayModel(
+                    record, unix_days(date), 51.6, rotating_atmosphere=True, near_circular_bins=coarse
+                )
+                runs.append(propagate(hp, ha, C_CUBESAT_M2_KG, model))
+            fine, near = (float(r.days[0]) for r in runs)
+            errors.append(near / fine - 1.0)
+            bins += [r.bins_used for r in runs]
+            orbit = f"{hp / 1e3:.0f}x{ha / 1e3:.0f}"
+            print(
+                f"{date:10} {orbit:>9} {fine:9.2f} {runs[0].bins_used:4d} {near:15.2f} {runs[1].bins_used:4d} "
+                f"{near / fine - 1:+8.3%}"
+            )
+    worst = np.abs(errors)
+    print(
+        f"{len(errors)} cases: median |change| {np.median(worst):.3%}, max {worst.max():.3%}; "
+        f"bins visited {bins[0]} fine, {bins[1]} near-circular"
+    )
+
+
 def main() -> None:
     only = sys.argv[1:]
     if only == ["short"]:
         short_lives()
+        return
+    if only == ["near-circular"]:
+        near_circular()
         return
     start = unix_days("2021-06-01")
     cases = [
@@ -104,7 +144,7 @@ def main() -> None:
         print(f"\n{name}: reference {reference:.2f} days ({t_ref:.1f} s)")
         print(f"{'chunk d':>8} {'bin step':>8} {'days':>9} {'error':>8} {'bins':>5} {'time s':>7}")
         for chunk, step in ((5, 0.1), (10, 0.1), (20, 0.1), (30, 0.1), (60, 0.1), (20, 0.05), (20, 0.2), (20, 0.4)):
-            model = SolarDecayModel(activity, start, 51.6, chunk_days=chunk, bin_step=step)
+            model = SolarDecayModel(activity, start, 51.6, chunk_days=chunk, bin_step=step, near_circular_bins=False)
             cached_curves.cache_clear()
             t = time.perf_counter()
             result = propagate(hp, ha, c, model)

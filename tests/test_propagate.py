@@ -27,7 +27,7 @@ def test_constant_activity_without_season_is_the_fixed_profile(msis):
     # F10.7 = e^5 and Ap = 12 fall on a bin, so the chunks use the very curves of the fixed profile;
     # only the 0.1 sfu rounding of the indices (< 0.1% in density) and Newton's steps differ.
     f = math.exp(5.0)
-    model = SolarDecayModel(ConstantActivity(f, f, 12.0), START, 51.6, follow_season=False)
+    model = SolarDecayModel(ConstantActivity(f, f, 12.0), START, 51.6, follow_season=False, near_circular_bins=False)
     hp = np.array([300e3, 400e3, 350e3])
     ha = np.array([300e3, 400e3, 600e3])
     chunked = propagate(hp, ha, SATELLITE.drag_parameter_m2_kg, model)
@@ -47,6 +47,43 @@ def test_vectorized_equals_one_by_one(msis):
     together = propagate(hp, hp, c, model).days
     alone = [propagate(hp[k], hp[k], c[k], model).days[0] for k in range(2)]
     assert together.tolist() == pytest.approx(alone, rel=1e-12)
+
+
+def test_near_circular_orbits_take_fewer_bins_within_half_a_percent(msis):
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+    from orbit_env.decay.solar_record import load_record
+
+    # The bound against today's path (the fine bins), on two of the 35 cases of
+    # `python benchmarks/measure_chunking.py near-circular` (max 0.42% there): a circular
+    # 350 km life of 9 months and a 20 km wide one of 2 years, from 2019.
+    record = load_record()
+    start = unix_days("2019-01-01")
+    hp, ha = np.array([350e3, 440e3]), np.array([350e3, 460e3])
+    runs = {
+        coarse: [
+            propagate(hp[k], ha[k], 0.0165, SolarDecayModel(record, start, 51.6, near_circular_bins=coarse))
+            for k in range(2)
+        ]
+        for coarse in (False, True)
+    }
+    for fine, near in zip(runs[False], runs[True], strict=True):
+        assert near.days[0] == pytest.approx(fine.days[0], rel=5e-3)
+        assert near.bins_used < fine.bins_used
+    assert sum(r.bins_used for r in runs[False]) >= 2 * sum(r.bins_used for r in runs[True])
+
+
+def test_a_satellites_bins_do_not_depend_on_the_others_in_the_vector(msis):
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+
+    model = SolarDecayModel(CycleActivity(), START, 51.6)
+    hp, ha = np.array([300e3, 280e3, 320e3]), np.array([305e3, 420e3, 320e3])  # near, wide, circular
+    together = propagate(hp, ha, 0.02, model, density_scale=np.array([1.0, 1.2, 0.9])).days
+    alone = [propagate(hp[k], ha[k], 0.02, model, density_scale=[1.0, 1.2, 0.9][k]).days[0] for k in range(3)]
+    assert together.tolist() == pytest.approx(alone, rel=1e-12)
+    # The near-circular ones alone take the coarse bins, the wide one the fine: a wide orbit's
+    # lifetime is not that of the near-circular bins.
+    fine = SolarDecayModel(CycleActivity(), START, 51.6, near_circular_bins=False)
+    assert propagate(hp[1], ha[1], 0.02, fine, density_scale=1.2).days[0] == alone[1]
 
 
 def test_chunked_matches_the_daily_reference_under_storms(msis):
