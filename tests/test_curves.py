@@ -117,3 +117,22 @@ def test_row_splines_are_scipys_cubic_spline():
         inside = np.clip(query, x[r, 0], x[r, n - 1])
         theirs = CubicSpline(x[r, :n], y[:, r, :n], axis=1)(inside)
         assert np.max(np.abs(ours[:, r] - theirs)) <= 1e-12 * np.max(np.abs(y[:, r, :n]))
+
+
+def test_lookups_before_the_cells_are_built_equal_those_after_bit_for_bit():
+    from orbit_env.decay.curves import BilinearGrid
+
+    # Until something asks for the cells, values() forms each point's coefficients from its
+    # four corners; the arithmetic is the same, so the results must be identical (no tolerance).
+    rng = np.random.default_rng(1)
+    tables = rng.normal(size=(3, 50, 40))
+    lazy, built = BilinearGrid(tables, 1.0, 0.5, -2.0, 0.25), BilinearGrid(tables, 1.0, 0.5, -2.0, 0.25)
+    assert built.cells.shape == (50 * 40, 3, 4)
+    x, y = rng.uniform(-1.0, 30.0, (20, 50)), rng.uniform(-3.0, 10.0, (20, 50))  # clamped edges included
+    for a, b in zip(lazy.values(x, y), built.values(x, y), strict=True):
+        np.testing.assert_array_equal(a, b)
+    for a, b in zip(lazy.values(3.3, y), built.values(3.3, y), strict=True):  # a scalar against an array
+        np.testing.assert_array_equal(a, b)
+    assert "cells" not in lazy.__dict__
+    scalar = [lazy.values_scalar(float(u), float(v)) for u, v in zip(x[0], y[0], strict=True)]
+    np.testing.assert_array_equal(np.array(scalar).T, np.array(lazy.values(x[0], y[0])))

@@ -129,6 +129,16 @@ def grid_cell(
     return i * int(ny) + j, fx - i, j, fy - j
 
 
+def _coefficients(f00: FloatArray, f10: FloatArray, f01: FloatArray, f11: FloatArray, out: FloatArray) -> None:
+    """A bilinear cell's coefficients from its corners into ``out[..., 0:4]`` (`BilinearGrid.cells`)."""
+    out[..., 0] = f00
+    np.subtract(f10, f00, out=out[..., 1])
+    np.subtract(f01, f00, out=out[..., 2])
+    np.subtract(f11, f10, out=out[..., 3])
+    out[..., 3] -= f01
+    out[..., 3] += f00
+
+
 class BilinearGrid:
     """Bilinear interpolation of a stack of tables (k, nx, ny) on a regular grid, clamped at its edges.
 
@@ -140,23 +150,18 @@ class BilinearGrid:
     vector environment's burning satellites (their cost is numpy's per-call
     overhead, not arithmetic). ``values`` and ``values_scalar`` do the same
     operations in the same order, so they give the same results, bit for bit.
+
+    The cells (four times the tables' size) are built the first time something asks for
+    them; until then ``values`` takes each point's four corners from the tables and forms
+    the same coefficients by the same operations, so the results are the same bit for bit
+    either way. A decay under the real Sun visits tens of bins' curves for a few lookups
+    each, where building the cells would be most of its time.
     """
 
     def __init__(self, tables: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
         k, nx, ny = tables.shape
-        # Written in place, table by table, into the cells' layout (no stacked temporaries: a dated
-        # decay builds these for every bin it visits).
-        padded = np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge").transpose(1, 2, 0)
-        f00, f10 = padded[:-1, :-1], padded[1:, :-1]
-        f01, f11 = padded[:-1, 1:], padded[1:, 1:]
-        cells = np.empty((nx, ny, k, 4))
-        cells[..., 0] = f00
-        np.subtract(f10, f00, out=cells[..., 1])
-        np.subtract(f01, f00, out=cells[..., 2])
-        np.subtract(f11, f10, out=cells[..., 3])
-        cells[..., 3] -= f01
-        cells[..., 3] += f00
-        self.cells = cells.reshape(nx * ny, k, 4)
+        #: The tables at every grid point, edges repeated once, shape (nx + 1, ny + 1, k).
+        self.corners = np.ascontiguousarray(np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge").transpose(1, 2, 0))
         self.k, self.nx, self.ny = k, nx, ny
         self.x_scale, self.x_offset = 1.0 / dx, x0 / dx
         self.y_scale, self.y_offset = 1.0 / dy, y0 / dy
@@ -171,6 +176,19 @@ class BilinearGrid:
             x_top=self.x_top,
             y_top=self.y_top,
         )
+
+    @cached_property
+    def cells(self) -> FloatArray:
+        """Each cell's bilinear coefficients of every table, shape (nx ny, k, 4); built on first use.
+
+        c0 = f00, c1 = f10 - f00, c2 = f01 - f00, c3 = f11 - f10 - f01 + f00 (corners f_ij).
+        """
+        padded = self.corners
+        f00, f10 = padded[:-1, :-1], padded[1:, :-1]
+        f01, f11 = padded[:-1, 1:], padded[1:, 1:]
+        cells = np.empty((self.nx, self.ny, self.k, 4))
+        _coefficients(f00, f10, f01, f11, cells)
+        return cells.reshape(self.nx * self.ny, self.k, 4)
 
     def _cells(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, NDArray[np.intp], FloatArray]:
         """Each point's cell (clamped to the grid): its coefficients (..., k, 4), tx, the y index j, ty."""
@@ -187,8 +205,18 @@ class BilinearGrid:
         tx = fx - i
         j = fy.astype(np.intp)
         ty = fy - j
-        i *= self.ny
-        cell = self.cells.take(i + j, axis=0)
+        if "cells" in self.__dict__:
+            i *= self.ny
+            cell = self.cells.take(i + j, axis=0)
+            return cell, tx, j, ty
+        # The cells not built: the four corners (the same coefficients, by the same operations).
+        corners = self.corners.reshape(-1, self.k)
+        row = i * (self.ny + 1) + j  # x and y broadcast against each other
+        f00, f01 = corners.take(row, axis=0), corners.take(row + 1, axis=0)
+        row += self.ny + 1
+        f10, f11 = corners.take(row, axis=0), corners.take(row + 1, axis=0)
+        cell = np.empty((*f00.shape, 4))
+        _coefficients(f00, f10, f01, f11, cell)
         return cell, tx, j, ty
 
     def values(self, x: ArrayLike, y: ArrayLike) -> list[FloatArray]:
