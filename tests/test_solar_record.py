@@ -115,3 +115,27 @@ def test_an_epoch_alone_means_nrlmsis_and_the_real_sun():
     )
     prepare(args)
     assert not isinstance(_scenario(args).activity, RecordActivity)
+
+
+def test_a_record_read_back_from_the_disk_cache_is_the_parsed_one(tmp_path, monkeypatch):
+    from orbit_env.decay import solar_record
+
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
+    parsed = read_record(SHIPPED_RECORD)
+    solar_record._load.cache_clear()
+    first = solar_record._load(str(SHIPPED_RECORD))  # parses and stores
+    assert len(list(tmp_path.glob("record-*"))) == 1
+    solar_record._load.cache_clear()
+    monkeypatch.setattr(solar_record, "read_record", pytest.fail)  # the file is not parsed again
+    cached = solar_record._load(str(SHIPPED_RECORD))
+    solar_record._load.cache_clear()
+    for record in (first, cached):
+        for name in ("days", "f107_sfu", "f107a_sfu", "ap"):
+            np.testing.assert_array_equal(getattr(record.table, name), getattr(parsed.table, name))
+        np.testing.assert_array_equal(record.kind, parsed.kind)
+        assert (record.observed_end_days, record.updated, record.files, record.source) == (
+            parsed.observed_end_days,
+            parsed.updated,
+            parsed.files,
+            parsed.source,
+        )

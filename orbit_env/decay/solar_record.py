@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env import cache
 from orbit_env.decay.solar import TableActivity, iso_date, unix_days
 
 FloatArray = NDArray[np.float64]
@@ -259,7 +260,24 @@ def load_record() -> RecordActivity:
 
 @lru_cache(maxsize=4)
 def _load(path: str) -> RecordActivity:
-    return read_record(path)
+    """`read_record`, its arrays kept in the disk cache per file, size and time (parsing takes 0.2 s a process)."""
+    stat = Path(path).stat()
+    description = cache.describe((path, stat.st_size, stat.st_mtime_ns))
+    stored = cache.load("record", description)
+    if stored is None:
+        record = read_record(path)
+        table = record.table
+        stored = {
+            "days": table.days,
+            "values": np.stack([table.f107_sfu, table.f107a_sfu, table.ap]),
+            "kind": record.kind,
+            "text": np.array([record.updated, record.files]),
+        }
+        cache.store("record", description, stored)
+    days, (f107, f107a, ap), kind = stored["days"], stored["values"], stored["kind"]
+    updated, files = (str(text) for text in stored["text"])
+    table = TableActivity(days, f107, f107a, ap, source=path)
+    return RecordActivity(table, float(days[kind == "o"][-1]), kind, updated, source=path, files=files)
 
 
 def update(path: str | Path) -> tuple[RecordActivity, Path]:
