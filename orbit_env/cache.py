@@ -85,7 +85,7 @@ def describe(value: Any) -> str | None:
 
 
 @functools.cache
-def _source_digest() -> str:
+def source_digest() -> str:
     """A hash of the package's Python source (read once per process: a few milliseconds)."""
     import importlib.util
 
@@ -106,7 +106,7 @@ def _path(kind: str, description: str) -> Path | None:
         return None
     from orbit_env import __version__
 
-    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{_source_digest()}|{description}"
+    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{source_digest()}|{description}"
     return folder / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
 
 

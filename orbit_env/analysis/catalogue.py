@@ -48,10 +48,11 @@ from __future__ import annotations
 import csv
 import os
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -111,6 +112,46 @@ class BatchSummary:
     rows: int
     ok: int
     groups: int
+
+
+@dataclass(frozen=True)
+class BatchOrbits:
+    """A batch file's rows as the decay takes them (heights above the 6371 km sphere).
+
+    Attributes:
+        rows: The rows' cells (`read_batch`; an element set's: its name).
+        perigee_m: Perigee heights [m].
+        apogee_m: Apogee heights [m].
+        drag_parameter_m2_kg: c = c_x A / m.
+        inclination_deg: Inclinations.
+        status: ``ok``, or why a row has no lifetime.
+        drag_sigma: Log-normal sigma of each row's drag parameter for ``--uncertainty`` (NaN:
+            a satellite of known mass and area, `orbit_env.analysis.uncertainty.DRAG_COEFFICIENT_SIGMA`).
+        epoch_days: Each row's element-set epoch [unix days] (NaN: none), which dates its
+            re-entry when the air has no date.
+    """
+
+    rows: list[dict[str, str]]
+    perigee_m: FloatArray
+    apogee_m: FloatArray
+    drag_parameter_m2_kg: FloatArray
+    inclination_deg: FloatArray
+    status: list[str]
+    drag_sigma: FloatArray
+    epoch_days: FloatArray
+
+    def part(self, start: int, stop: int) -> BatchOrbits:
+        """Rows ``start`` to ``stop`` (excluded)."""
+        return BatchOrbits(
+            self.rows[start:stop],
+            self.perigee_m[start:stop],
+            self.apogee_m[start:stop],
+            self.drag_parameter_m2_kg[start:stop],
+            self.inclination_deg[start:stop],
+            self.status[start:stop],
+            self.drag_sigma[start:stop],
+            self.epoch_days[start:stop],
+        )
 
 
 def _number(row: dict[str, str], key: str, **bounds: Any) -> float | None:
@@ -433,19 +474,19 @@ def batch_lifetimes(
     for i, row in enumerate(rows):
         record: dict[str, Any] = {key: row[key] for key in _ID_COLUMNS if key in row}
         record.update(
-            perigee_km=_fmt(perigee_m[i] / 1e3),
-            apogee_km=_fmt(apogee_m[i] / 1e3),
-            inclination_deg=_fmt(inclination_deg[i]),
-            drag_parameter_m2_kg=_fmt(drag_parameter_m2_kg[i]),
-            days=_fmt(days[i]) if status[i] == "ok" and reentered[i] else "",
-            years=_fmt(days[i] / 365.25) if status[i] == "ok" and reentered[i] else "",
+            perigee_km=format_value(perigee_m[i] / 1e3),
+            apogee_km=format_value(apogee_m[i] / 1e3),
+            inclination_deg=format_value(inclination_deg[i]),
+            drag_parameter_m2_kg=format_value(drag_parameter_m2_kg[i]),
+            days=format_value(days[i]) if status[i] == "ok" and reentered[i] else "",
+            years=format_value(days[i] / 365.25) if status[i] == "ok" and reentered[i] else "",
         )
         if rule_years is not None:
             good = status[i] == "ok"
             record.update(
                 complies=str(bool(complies[i])).lower() if good else "",
-                new_perigee_km=_fmt(new_hp[i] / 1e3) if good else "",
-                dv_m_s=_fmt(dv[i]) if good else "",
+                new_perigee_km=format_value(new_hp[i] / 1e3) if good else "",
+                dv_m_s=format_value(dv[i]) if good else "",
             )
         record["status"] = status[i]
         records.append(record)
@@ -585,7 +626,8 @@ def _life_rate_ratio(
     return ratio
 
 
-def _fmt(value: float) -> str:
+def format_value(value: float) -> str:
+    """A number as the results file writes it: six significant digits, empty if not finite."""
     return "" if not np.isfinite(value) else f"{value:.6g}"
 
 
@@ -618,12 +660,11 @@ def check_output(path: str | Path, input_path: str | Path, *, force: bool = Fals
         raise ValueError(f"--out {path}: cannot write in {folder} ({error.strerror or error})") from None
 
 
-def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
-    """Write output records as CSV with LF line endings, atomically.
+@contextmanager
+def atomic_text(path: str | Path) -> Iterator[TextIO]:
+    """A text file written whole or not at all: a temporary file beside ``path``, renamed to it once complete.
 
-    The rows go to a temporary file beside ``path``, renamed to ``path`` once
-    complete: a reader never sees half a file, and a failure leaves any earlier
-    file as it was.
+    A reader never sees half a file, and a failure leaves any earlier file as it was.
     """
     out = Path(path)
     handle = tempfile.NamedTemporaryFile(
@@ -631,9 +672,7 @@ def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
     )
     try:
         with handle:
-            writer = csv.DictWriter(handle, fieldnames=list(records[0]), lineterminator="\n")
-            writer.writeheader()
-            writer.writerows(records)
+            yield handle
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(handle.name, 0o666 & ~umask)  # a temporary file is private; the results are not
@@ -641,3 +680,11 @@ def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
     except BaseException:
         Path(handle.name).unlink(missing_ok=True)
         raise
+
+
+def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
+    """Write output records as CSV with LF line endings, atomically (`atomic_text`)."""
+    with atomic_text(path) as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(records[0]), lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(records)

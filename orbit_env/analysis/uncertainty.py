@@ -68,6 +68,8 @@ SOLAR_NODES = (-2.0, -1.0, 0.0, 1.0, 2.0)
 PERCENTILES = (5, 50, 95)
 #: The confidence STELA asks of the disposal rule ("within 25 years with probability >= 0.9").
 RULE_CONFIDENCE = 0.9
+#: Allowed numbers of samples.
+SAMPLES_RANGE = (10, 1_000_000)
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,12 +136,22 @@ def sample_factors(
     samples: int, seed: int, drag_sigma: float = DRAG_COEFFICIENT_SIGMA
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The samples' solar z, density factor and drag factor (sigma ``drag_sigma``; seeded: the same twice)."""
-    n = check_int(samples, "samples", low=10, high=1_000_000)
+    n = check_samples(samples)
     rng = np.random.default_rng(check_int(seed, "seed", low=0))
     z_sun = rng.standard_normal(n)
     density = np.exp(DENSITY_MODEL_SIGMA * rng.standard_normal(n))
     drag = np.exp(drag_sigma * rng.standard_normal(n))
     return z_sun, density, drag
+
+
+def check_samples(samples: int) -> int:
+    """The number of samples, checked against `SAMPLES_RANGE`.
+
+    Raises:
+        InputError: outside the range.
+    """
+    low, high = SAMPLES_RANGE
+    return check_int(samples, "samples", low=low, high=high)
 
 
 def lifetime_spread(

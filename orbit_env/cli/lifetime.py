@@ -28,8 +28,8 @@ from orbit_env.analysis.lifetime import (
 )
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import check_number
-from orbit_env.cli import orbit_inputs
-from orbit_env.cli.common import PROG, check_finite, flag, given, number, write_csv
+from orbit_env.cli import orbit_inputs, uncertain_batch
+from orbit_env.cli.common import PROG, check_finite, flag, given, number, positive_int, write_csv
 from orbit_env.decay.solar import (
     TableActivity,
     iso_date,
@@ -112,6 +112,7 @@ def _json(summary: dict[str, Any]) -> str:
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
     _check_inclination(args)
+    uncertain_batch.check_options(args)
     orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
     satellite, drag_source, drag_report = orbit_inputs.satellite_from_args(args, orbit, scenario)
@@ -203,7 +204,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
 
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
-    from orbit_env.analysis.catalogue import batch_lifetimes, check_output, read_batch, write_records
+    from orbit_env.analysis.catalogue import batch_lifetimes, check_output, write_records
+    from orbit_env.analysis.catalogue_parts import parts_folder
 
     if not args.out:
         raise ValueError("--batch needs --out CSV for the results")
@@ -216,34 +218,48 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
         raise ValueError("--batch always uses the universal curves; do not give --method")
     check_output(args.out, args.batch, force=args.force)
     start = time.perf_counter()
-    rows, hp, ha, c, inc, status = orbit_inputs.read_orbits(args, satellite, read_batch, scenario)
-    records, summary = batch_lifetimes(
-        rows,
-        hp,
-        ha,
-        c,
-        inc,
-        status,
-        scenario.in_sphere_heights(args.height_reference, args.inclination),
-        rule_years=args.rule,
-        progress=not args.no_progress,
-    )
-    write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
+    orbits = orbit_inputs.read_orbits(args, satellite, scenario)
+    air = scenario.in_sphere_heights(args.height_reference, args.inclination)
+    if args.uncertainty:
+        try:
+            joined = uncertain_batch.run(args, orbits, air)
+        except KeyboardInterrupt:
+            print(
+                f"{PROG}: stopped; the finished chunks are kept in {parts_folder(args.out)}: the same command "
+                "resumes from them",
+                file=sys.stderr,
+            )
+            return 130
+        rows, ok, first, max_days = joined.rows, joined.ok, joined.first_status, joined.max_days
+    else:
+        records, summary = batch_lifetimes(
+            orbits.rows,
+            orbits.perigee_m,
+            orbits.apogee_m,
+            orbits.drag_parameter_m2_kg,
+            orbits.inclination_deg,
+            orbits.status,
+            air,
+            rule_years=args.rule,
+            progress=not args.no_progress,
+        )
+        write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
+        rows, ok = summary.rows, summary.ok
+        first = next((record["status"] for record in records if record["status"] != "ok"), None)
+        max_days = max((float(record["days"]) for record in records if record["days"]), default=0.0)
     if scenario.epoch_days is not None:
-        lived = [float(record["days"]) for record in records if record["days"]]
-        _warn_solar_table(scenario, scenario.epoch_days + max(lived, default=0.0))
+        _warn_solar_table(scenario, scenario.epoch_days + max_days)
     elapsed = time.perf_counter() - start
     print(
-        f"wrote {summary.rows} rows to {args.out} ({summary.ok} with lifetimes, {summary.rows - summary.ok} with a "
+        f"wrote {rows} rows to {args.out} ({ok} with lifetimes, {rows - ok} with a "
         f"status message) in {elapsed:.2f} s; atmosphere {_atmosphere(args, scenario)}"
     )
-    if summary.ok == summary.rows:
+    if ok == rows:
         return 0
     # Exit status 1: the results file is complete, but some rows have no lifetime (documented in
     # docs/how-to/catalogue.md); one line on stderr says how many and the first reason.
-    first = next(record["status"] for record in records if record["status"] != "ok")
     print(
-        f"{PROG}: {summary.rows - summary.ok} of {summary.rows} rows have no lifetime (first: {first}); "
+        f"{PROG}: {rows - ok} of {rows} rows have no lifetime (first: {first}); "
         f"the status column of {args.out} says why for each",
         file=sys.stderr,
     )
@@ -370,8 +386,24 @@ def add_parsers(sub: Any) -> None:
         "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
     )
     life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
-    life.add_argument("--force", action="store_true", help="with --batch: replace an existing --out file")
+    life.add_argument(
+        "--force",
+        action="store_true",
+        help="with --batch: replace an existing --out file (with --uncertainty: and delete another run's parts)",
+    )
     life.add_argument("--no-progress", action="store_true", help="with --batch: no progress bar")
+    life.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="with --batch --uncertainty: processes for the chunks of rows (default: all cores, os.cpu_count())",
+    )
+    life.add_argument(
+        "--address",
+        metavar="RAY_ADDRESS",
+        help="with --batch --uncertainty: run the chunks as Ray tasks on this cluster ('local': start a local Ray; "
+        "the cluster extra); the same file as a local run",
+    )
     orbit_inputs.add_uncertainty_options(life)
     life.add_argument("--json", action="store_true", help="print one JSON object")
     life.add_argument("--trajectory", metavar="CSV", help="write the decay history to a CSV file")

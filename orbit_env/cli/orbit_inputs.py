@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from orbit_env.analysis.air import DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.drag_calibration import SOURCE_BSTAR_CALIBRATED
@@ -24,6 +24,9 @@ from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
 from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.cli.common import given, number
+
+if TYPE_CHECKING:
+    from orbit_env.analysis.catalogue import BatchOrbits
 
 #: What ``drag_parameter_source`` says in JSON.
 SOURCE_BSTAR = "bstar"
@@ -374,7 +377,7 @@ def history_rows(history: Any, offset: float, epoch_days: float | None = None) -
     return rows
 
 
-def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any, scenario: Any) -> tuple[Any, ...]:
+def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -> BatchOrbits:
     """A batch file's orbits in the sphere's heights [m]: a CSV (see ``catalogue``) or element sets.
 
     Element sets give the heights of the orbit flown above the equatorial radius, their
@@ -384,6 +387,7 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any,
     """
     import numpy as np
 
+    from orbit_env.analysis.catalogue import BatchOrbits, read_batch
     from orbit_env.analysis.drag_calibration import calibrate, fit_history
     from orbit_env.analysis.elements import looks_like_tle, read_tle
 
@@ -394,7 +398,8 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any,
         rows, hp, ha, c, inc, status = read_batch(
             args.batch, satellite.drag_coefficient, satellite.drag_parameter_m2_kg, args.inclination
         )
-        return rows, hp + offset_m, ha + offset_m, c, inc, status
+        none = np.full(len(rows), np.nan)
+        return BatchOrbits(rows, hp + offset_m, ha + offset_m, c, inc, status, none, none)
     if args.height_reference != "equatorial":
         raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
     histories: dict[str, list[Any]] = {}
@@ -408,6 +413,7 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any,
     ha = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
     inc = np.array([s.inclination_deg for s in latest])
     c = np.full(len(latest), satellite.drag_parameter_m2_kg)
+    sigma = np.full(len(latest), np.nan)
     status = ["ok"] * len(latest)
     air = scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0))
     for i, (s, sets) in enumerate(zip(latest, objects, strict=True)):
@@ -415,13 +421,14 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any,
             continue
         try:
             if len(sets) > 1:
-                c[i] = fit_history(sets, air).drag_parameter_m2_kg
+                fit = fit_history(sets, air)
+                c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
             else:
                 calibration = calibrate(s, air)
                 if calibration is None:
                     status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
                 else:
-                    c[i] = calibration.drag_parameter_m2_kg
+                    c[i], sigma[i] = calibration.drag_parameter_m2_kg, ONE_SET_DRAG_SIGMA
         except ValueError as error:
             status[i] = f"line {s.line}: {error}"
     from orbit_env.decay.curves import UniversalCurves
@@ -432,7 +439,8 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, read_batch: Any,
                 UniversalCurves.check_domain(hp[i], ha[i])
             except ValueError as error:
                 status[i] = f"line {latest[i].line}: {error}"
-    return rows, hp, ha, c, inc, status
+    epochs = np.array([s.epoch_days for s in latest], dtype=np.float64)
+    return BatchOrbits(rows, hp, ha, c, inc, status, sigma, epochs)
 
 
 def records_in_reference(records: list[dict[str, Any]], reference: str) -> list[dict[str, Any]]:
@@ -456,7 +464,8 @@ def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
         "--uncertainty",
         action="store_true",
         help="Monte Carlo over the solar forecast, NRLMSIS's error and the drag coefficient: percentiles, "
-        "and with --rule the probability of compliance",
+        "and with --rule the probability of compliance; with --batch, every row's (seeded by the row), in "
+        "chunks over --workers processes, resumed from OUT.parts/ by the same command",
     )
     group.add_argument("--samples", type=positive_int, default=1000, help="with --uncertainty: samples (default 1000)")
     group.add_argument("--seed", type=int, default=0, help="with --uncertainty: random seed (default 0)")
