@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 import sys
 
 import numpy as np
@@ -271,3 +272,29 @@ def test_local_ray_writes_the_same_file(capsys, tmp_path):
     status, stdout, _, ray = batch(capsys, tmp_path, SATELLITES, "sats.csv", "ray.csv", *options, "--address", "local")
     assert status == 1 and "Ray at local" in stdout
     assert ray.read_bytes() == here.read_bytes()
+
+
+class DiesAt:
+    """A chunk computation whose worker process dies at row ``row`` (as one killed by the system)."""
+
+    def __init__(self, row):
+        self.row = row
+
+    def __call__(self, start, stop):
+        if start <= self.row < stop:
+            os._exit(1)
+        return [{"name": f"r{i}", "days": str(i + 1), "status": "ok"} for i in range(start, stop)]
+
+
+def test_a_lost_worker_keeps_the_finished_chunks(tmp_path):
+    from concurrent.futures.process import BrokenProcessPool
+
+    out = tmp_path / "out.csv"
+    whole = tmp_path / "whole.csv"
+    catalogue_parts.run_in_parts(whole, "0" * 16, 40, 5, DiesAt(-1), workers=1, progress=False, report=print)
+    with pytest.raises(BrokenProcessPool):
+        catalogue_parts.run_in_parts(out, "0" * 16, 40, 5, DiesAt(37), workers=2, progress=False, report=print)
+    # The eighth chunk is sent once four have finished (four at most waiting on two workers): those are kept.
+    assert not out.exists() and len(list(catalogue_parts.parts_folder(out).iterdir())) >= 4
+    joined = catalogue_parts.run_in_parts(out, "0" * 16, 40, 5, DiesAt(-1), workers=2, progress=False, report=print)
+    assert out.read_bytes() == whole.read_bytes() and (joined.rows, joined.ok, joined.max_days) == (40, 40, 40.0)

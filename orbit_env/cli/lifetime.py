@@ -204,6 +204,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
 
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
+    from concurrent.futures.process import BrokenProcessPool
+
     from orbit_env.analysis.catalogue import batch_lifetimes, check_output, write_records
     from orbit_env.analysis.catalogue_parts import parts_folder
 
@@ -223,13 +225,14 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
     if args.uncertainty:
         try:
             joined = uncertain_batch.run(args, orbits, air)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, BrokenProcessPool) as stop:
+            why = "stopped" if isinstance(stop, KeyboardInterrupt) else f"a worker process died ({stop})"
             print(
-                f"{PROG}: stopped; the finished chunks are kept in {parts_folder(args.out)}: the same command "
+                f"{PROG}: {why}; the finished chunks are kept in {parts_folder(args.out)}: the same command "
                 "resumes from them",
                 file=sys.stderr,
             )
-            return 130
+            return 130 if isinstance(stop, KeyboardInterrupt) else 2
         rows, ok, first, max_days = joined.rows, joined.ok, joined.first_status, joined.max_days
     else:
         records, summary = batch_lifetimes(
