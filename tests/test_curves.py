@@ -134,5 +134,11 @@ def test_lookups_before_the_cells_are_built_equal_those_after_bit_for_bit():
     for a, b in zip(lazy.values(3.3, y), built.values(3.3, y), strict=True):  # a scalar against an array
         np.testing.assert_array_equal(a, b)
     assert "cells" not in lazy.__dict__
+    from orbit_env.decay.curves import CORNER_LOOKUPS
+
+    for _ in range(CORNER_LOOKUPS):  # a grid looked up this often builds its cells
+        lazy.values(x[0], y[0])
+    assert "cells" in lazy.__dict__
+    np.testing.assert_array_equal(np.array(lazy.values(x, y)), np.array(built.values(x, y)))
     scalar = [lazy.values_scalar(float(u), float(v)) for u, v in zip(x[0], y[0], strict=True)]
     np.testing.assert_array_equal(np.array(scalar).T, np.array(lazy.values(x[0], y[0])))
