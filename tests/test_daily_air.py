@@ -91,3 +91,16 @@ def test_the_decays_density_ratio_equals_nrlmsis_directly(follow_season):
     bin_rho = mean_density_kg_m3(RATIO_GRID_M, *binned[:1] * 2, binned[1], 51.6, None, None, **RATIO_NODES)
     np.testing.assert_allclose(model.log_ratio(daily, binned), np.log(exact / bin_rho), rtol=1e-10, atol=1e-12)
     assert len(air_table(51.6, None, model.version)) >= len(set(daily)) + SEASON_NODES
+
+
+def test_the_table_is_rewritten_when_it_has_grown_by_a_quarter_and_at_the_end(tmp_path, monkeypatch):
+    days = [(100.0 + k, 100.0, 10.0, 100.0) for k in range(40)]
+    table(tmp_path, monkeypatch).log_density(days[:20])  # an empty table grows: written
+    air = table(tmp_path, monkeypatch)
+    air.log_density(days[20:24])  # 24 < 1.25 x 20 rows: not written yet
+    assert len(table(tmp_path, monkeypatch)) == 20
+    air.log_density(days[24:26])  # 26 >= 25: written
+    assert len(table(tmp_path, monkeypatch)) == 26
+    air.log_density(days[26:27])
+    daily_air._store_all()  # what the end of the process runs
+    assert len(table(tmp_path, monkeypatch)) == 27

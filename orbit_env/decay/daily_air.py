@@ -13,14 +13,18 @@ record, an imported table and the uncertainty's scaled forecasts alike.
 A row is computed the first time it is asked for, together with the rows of the days
 ahead the caller names (a year, one NRLMSIS call: about 0.6 s at 6 x 6 orbit samples and 23
 heights), and the table is written to the disk cache (`orbit_env.cache`, kind
-``"airdays"``) whenever it grew: a later run, in any process, reads it in milliseconds
-and calls NRLMSIS only for days it has never seen. The rows are NRLMSIS's own values for
-those indices (a memo, not an interpolation), so results do not change with what is
-cached. Units: SI (m, kg/m^3).
+``"airdays"``) when it has grown by a quarter since it was last written, and when the
+process ends: a later run, in any process, reads it in milliseconds and calls NRLMSIS
+only for days it has never seen. (Written at every growth, the uncertainty's samples,
+whose scaled forecasts are days never seen, rewrote a growing table hundreds of times.)
+The rows are NRLMSIS's own values for those indices (a memo, not an interpolation), so
+results do not change with what is cached. Units: SI (m, kg/m^3).
 """
 
 from __future__ import annotations
 
+import atexit
+import weakref
 from collections.abc import Callable, Sequence
 from functools import lru_cache
 
@@ -33,6 +37,9 @@ from orbit_env.physics.atmosphere.msis import orbit_mean_density_by_day_kg_m3
 FloatArray = NDArray[np.float64]
 #: A day's indices as the decay rounds them: (F10.7 [sfu], 81-day mean [sfu], Ap, day of the year 1-366).
 DayKey = tuple[float, float, float, float]
+#: A table is written again when it holds this many times the rows it held when last written (or read).
+STORE_GROWTH = 1.25
+_TABLES: weakref.WeakSet[DailyAirTable] = weakref.WeakSet()
 
 
 class DailyAirTable:
@@ -79,6 +86,8 @@ class DailyAirTable:
         else:
             self._keys, self._log_rho = stored["keys"], stored["log_density"]
         self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(tuple, self._keys.tolist()))}
+        self._stored_rows = len(self._row_of)
+        _TABLES.add(self)
 
     def __len__(self) -> int:
         """The number of days' indices held."""
@@ -118,8 +127,22 @@ class DailyAirTable:
         self._keys = np.concatenate([self._keys, np.array(new, dtype=np.float64)])
         self._log_rho = np.concatenate([self._log_rho, np.log(rho)])
         self._row_of.update({key: start + k for k, key in enumerate(new)})
-        # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
-        cache.store("airdays", self._description, {"keys": self._keys, "log_density": self._log_rho}, compress=False)
+        if len(self) >= STORE_GROWTH * self._stored_rows:
+            self.store()
+
+    def store(self) -> None:
+        """Write the table to the disk cache if it holds rows not written yet."""
+        if len(self) > self._stored_rows:
+            # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
+            arrays = {"keys": self._keys, "log_density": self._log_rho}
+            cache.store("airdays", self._description, arrays, compress=False)
+            self._stored_rows = len(self)
+
+
+@atexit.register
+def _store_all() -> None:
+    for table in list(_TABLES):
+        table.store()
 
 
 @lru_cache(maxsize=64)
