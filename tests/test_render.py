@@ -75,3 +75,25 @@ def test_human_rendering_without_a_window_warns_once_and_draws_nothing(monkeypat
     with pytest.warns(UserWarning, match="an interactive matplotlib backend"):
         env.reset(seed=0)
     env.close()
+
+
+def test_rgb_array_frames_are_blitted_and_equal_a_full_redraw():
+    import numpy as np
+
+    from orbit_env.envs.render import TrackRenderer
+
+    # Frames restore the background's pixels and draw only the track, the burns, the current point and
+    # the title; each must be the very image a full redraw gives (also after the x range grows past
+    # 1700 km, which redraws the background).
+    renderer = TrackRenderer(human=False, fps=8.0)
+    track = [(300e3 + k * 1e3, 800e3 + k * 40e3, 1.0 if k % 3 == 0 else 0.0) for k in range(30)]
+    for k in (1, 5, 20, 30):  # apogee up to 1960 km from k = 24 on
+        frame = renderer.draw(track[:k], time_days=float(k), dv_left_m_s=100.0 - k)
+        for artist in renderer._moving:
+            artist.set_animated(False)
+        renderer.figure.canvas.draw()
+        full = np.asarray(renderer.figure.canvas.buffer_rgba())[:, :, :3]
+        np.testing.assert_array_equal(frame, full)
+        for artist in renderer._moving:
+            artist.set_animated(True)
+        renderer._background = None  # the full redraw drew the moving artists into the canvas
