@@ -386,14 +386,11 @@ class SolarDecayModel:
         _, f107a, ap = self.activity.indices(days)
         return daily, bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step, self.ap_bins)
 
-    def binned_for(self, perigee_m: FloatArray, apogee_m: FloatArray) -> SolarDecayModel:
-        """This model, or the same on the near-circular bins (no finer than its own).
+    def near_circular(self) -> SolarDecayModel:
+        """The same model on the near-circular bins (no finer than its own).
 
-        The latter when ``near_circular_bins`` and every orbit is within `NEAR_CIRCULAR_SPAN_M` of circular.
+        `propagate` gives them to the orbits within `NEAR_CIRCULAR_SPAN_M` of circular when ``near_circular_bins``.
         """
-        span_m = np.max(np.asarray(apogee_m) - np.asarray(perigee_m), initial=0.0)
-        if not self.near_circular_bins or span_m > NEAR_CIRCULAR_SPAN_M:
-            return self
         return replace(self, bin_step=max(self.bin_step, NEAR_CIRCULAR_BIN_STEP), ap_bins=NEAR_CIRCULAR_AP_BINS)
 
     def chunk_samples(self, t_days: float) -> FloatArray:
@@ -829,7 +826,7 @@ def propagate(
     (docs/validation-modern.md, section 7).
 
     Orbits within `NEAR_CIRCULAR_SPAN_M` of circular are propagated on the near-circular
-    bins (`SolarDecayModel.binned_for`), the others on the model's, each group on its own,
+    bins (`SolarDecayModel.near_circular`), the others on the model's, each group on its own,
     so a satellite's lifetime does not depend on the others in the vector. With
     ``record``, a vector holding both kinds takes the model's bins for all (one history).
 
@@ -854,10 +851,10 @@ def propagate(
     )
     near = (ha - hp <= NEAR_CIRCULAR_SPAN_M) if model.near_circular_bins else np.zeros(hp.size, dtype=bool)
     if near.all() or not near.any() or record:
-        fixed = model.binned_for(hp, ha) if near.all() else model
+        fixed = model.near_circular() if near.size and near.all() else model
         return _propagate(hp, ha, c, scale, fixed, record, progress, inclination_deg)
     days, reentered, bins_used, done = np.empty(hp.size), np.empty(hp.size, dtype=bool), 0, 0
-    for group, group_model in ((near, model.binned_for(hp[near], ha[near])), (~near, model)):
+    for group, group_model in ((near, model.near_circular()), (~near, model)):
         count = int(group.sum())
 
         def group_progress(fraction: float, before: int = done, count: int = count) -> None:

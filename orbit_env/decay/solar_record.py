@@ -238,7 +238,14 @@ def read_record(path: str | Path) -> RecordActivity:
     days = np.array([r[0] for r in rows], dtype="datetime64[D]").astype(np.int64).astype(np.float64)
     values = np.array([[float(r[1]), float(r[2]), float(r[3])] for r in rows])
     kind = np.array([r[4] for r in rows])
-    table = TableActivity(days, values[:, 0], values[:, 1], values[:, 2], source=source)
+    return _record(days, values.T, kind, updated, files, source)
+
+
+def _record(
+    days: FloatArray, values: FloatArray, kind: NDArray[np.str_], updated: str, files: str, source: str
+) -> RecordActivity:
+    """The record of these rows (``values``: F10.7, its 81-day mean and Ap, one row each)."""
+    table = TableActivity(days, *values, source=source)
     return RecordActivity(table, float(days[kind == "o"][-1]), kind, updated, source=source, files=files)
 
 
@@ -274,10 +281,9 @@ def _load(path: str) -> RecordActivity:
             "text": np.array([record.updated, record.files]),
         }
         cache.store("record", description, stored)
-    days, (f107, f107a, ap), kind = stored["days"], stored["values"], stored["kind"]
+        return record
     updated, files = (str(text) for text in stored["text"])
-    table = TableActivity(days, f107, f107a, ap, source=path)
-    return RecordActivity(table, float(days[kind == "o"][-1]), kind, updated, source=path, files=files)
+    return _record(stored["days"], stored["values"], stored["kind"], updated, files, path)
 
 
 def update(path: str | Path) -> tuple[RecordActivity, Path]:
