@@ -7,7 +7,9 @@ to a few weeks) all lie in 0 to 0.08. This extractor passes the observation on
 and appends ln(L / 365 d) = logit(component 4) and ln(1 - t), so that a linear
 layer already forms ln(L / time left). It has no parameters and needs nothing
 but the observation: the environment is unchanged, and a saved model carries
-the class by name (``orbit_env.agents.features``).
+the class by name (``orbit_env.agents.features``). The components it reads and the
+clamp are `orbit_env.envs.wrappers`' (``CLOCK``, ``LIFETIME``, ``LOG_FLOOR``), whose
+observation wrappers append the same features outside the network for other libraries.
 """
 
 from __future__ import annotations
@@ -16,12 +18,9 @@ import gymnasium
 import torch
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
-from orbit_env.envs.task import OBS_INDEX
+from orbit_env.envs.wrappers import CLOCK, LIFETIME, LOG_FLOOR
 
-#: Observation components it reads (the task model's layout, `orbit_env.envs.task.OBS_INDEX`).
-CLOCK, LIFETIME = OBS_INDEX["mission_clock"], OBS_INDEX["predicted_lifetime"]
-#: Clamp before the logarithms: a lifetime of about 30 s, a clock a step before 1 of a 365-step mission.
-LOG_FLOOR = 1e-6
+__all__ = ["CLOCK", "LIFETIME", "LOG_FLOOR", "LogFeatures"]
 
 
 class LogFeatures(BaseFeaturesExtractor):
