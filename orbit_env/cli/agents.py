@@ -49,6 +49,10 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     def warn(message: str) -> None:
         print(f"{PROG}: warning: {message}", file=sys.stderr)
 
+    from orbit_env.envs import SOLAR_ENV_ID
+
+    if args.env == SOLAR_ENV_ID:
+        return _evaluate_solar(args, say)
     check_env_id(args.env)
     if args.certify:
         return _certify(args, say)
@@ -77,6 +81,62 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     else:
         found = [pair for pair in paired.values() if pair is not None]
         print(format_table(args.env, args.episodes, args.seed, table, found))
+    return 0
+
+
+def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
+    """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
+    from orbit_env.agents.evaluate import format_table, paired_difference, summarize
+    from orbit_env.agents.solar import evaluate_solar, solar_report
+
+    if args.model is not None:
+        print(
+            f"{PROG}: warning: no learned agent of OrbitRaisingSolar-v0 is scored yet; --model ignored", file=sys.stderr
+        )
+    evaluation = evaluate_solar(
+        args.episodes,
+        args.seed,
+        solar_split=args.solar_split,
+        disposal_years=args.disposal_years,
+        include_dp=not args.no_dp,
+        workers=args.workers,
+        progress=say,
+    )
+    results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
+    table = summarize(results)
+    report = solar_report(evaluation)
+    paired = [paired_difference(results, name="dp")] if "dp" in results else []
+    if args.json:
+        out = {
+            "env": args.env,
+            "episodes": args.episodes,
+            "seed": args.seed,
+            "solar_split": args.solar_split,
+            "disposal_years": args.disposal_years,
+            "policies": {name: {**row, **report["policies"][name]} for name, row in table.items()},
+            **{key: value for key, value in report.items() if key != "policies"},
+        }
+        if paired and paired[0] is not None:
+            out["paired_difference"] = paired[0]
+        print(json.dumps(out))
+        return 0
+    print(
+        format_table(
+            f"{args.env} ({args.solar_split} split)", args.episodes, args.seed, table, [p for p in paired if p]
+        )
+    )
+    for name, row in report["policies"].items():
+        print(
+            f"  {name:<17} disposal burn on {row['disposal_share']:6.1%}, "
+            f"non-compliant {row['noncompliant_share']:6.1%}, re-entered {row['reentered_share']:6.1%}"
+        )
+    print(f"thresholds tuned on the train split: {report['tuned']}")
+    if "certificate" in report:
+        cert = report["certificate"]
+        print(
+            f"certificate: the DP grid's estimate less the return its policy flew: mean {cert['mean_gap_days']:+.2f}, "
+            f"largest {cert['max_gap_days']:+.2f} days; episodes where a rule beat the DP: {cert['beaten_by_a_rule']}"
+        )
     return 0
 
 
@@ -168,6 +228,25 @@ def add_parsers(sub: Any) -> None:
         "--certify",
         action="store_true",
         help="instead, search for plans that beat the DP policy on the episodes' starts; report the gap found",
+    )
+    ev.add_argument(
+        "--solar-split",
+        choices=("train", "test"),
+        default="test",
+        help="OrbitRaisingSolar-v0: the record's split the missions are drawn from (default test: cycles 24-25)",
+    )
+    ev.add_argument(
+        "--disposal-years",
+        type=float,
+        default=5.0,
+        metavar="Y",
+        help="OrbitRaisingSolar-v0: the disposal rule, re-entry within Y years of the mission's end (default 5)",
+    )
+    ev.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="OrbitRaisingSolar-v0: processes solving the DPs (default: cores)",
     )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")

@@ -625,30 +625,6 @@ class SolarLifetime:
     bins_used: int
 
 
-def _weight_at(curves: UniversalCurves, label: FloatArray, nu: FloatArray) -> tuple[FloatArray, ...]:
-    hp, ha, q = curves.at(label, np.log1p(nu / NU_REF))
-    return hp, ha, q * nu
-
-
-def _solve_nu(
-    curves: UniversalCurves,
-    label: FloatArray,
-    nu: FloatArray,
-    w0: FloatArray,
-    target: FloatArray,
-    hp: FloatArray,
-    ha: FloatArray,
-) -> FloatArray:
-    """Newton on W(nu) = target from nu (where W = w0, heights hp, ha), dW/dnu = P."""
-    p_now, e_now = elements_from_heights(hp, ha)
-    nu = np.maximum(nu - (w0 - target) / period_s(p_now, e_now), 0.0)
-    for _ in range(3):
-        hp_k, ha_k, w = _weight_at(curves, label, nu)
-        p_k, e_k = elements_from_heights(hp_k, ha_k)
-        nu = np.maximum(nu - (w - target) / period_s(p_k, e_k), 0.0)
-    return nu
-
-
 def _daily_steps(
     model: SolarDecayModel,
     curves: UniversalCurves,
@@ -696,7 +672,7 @@ def _daily_steps(
             offsets=None if offsets is None else offsets[which],
             inclination_deg=None if inclination_deg is None else inclination_deg[which],
         )
-        _, _, w0 = _weight_at(curves, label[which], nu[which])
+        _, _, w0 = curves.weighted_at(label[which], nu[which])
         return w0, gcs[which] * ratio
 
     def move(which: NDArray[np.intp], start: float, length: float, w0: FloatArray, rate: FloatArray) -> None:
@@ -705,8 +681,8 @@ def _daily_steps(
         days[which[ended]] = start + w0[ended] / rate[ended] / SECONDS_PER_DAY
         going = which[~ended]
         if going.size:
-            nu[going] = _solve_nu(curves, label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
-            hp[going], ha[going], _ = _weight_at(curves, label[going], nu[going])
+            nu[going] = curves.nu_at_weight(label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
+            hp[going], ha[going], _ = curves.weighted_at(label[going], nu[going])
         if ended.any():
             nu[which[ended]] = 0.0
             hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))
@@ -928,7 +904,7 @@ def _propagate(
             s = s * spread.wide_factor(model, curves, daily, binned, active, offsets, hp, ha, s, new_bin)
         rate = gcs[active] * s  # dW/dt: W falls by this per second
         nu0 = NU_REF * np.expm1(tau)
-        _, _, w0 = _weight_at(curves, label, nu0)
+        _, _, w0 = curves.weighted_at(label, nu0)
         # Near re-entry (less than FINE_CHUNKS chunks of decay left at this rate) the chunk goes day by day;
         # the others cannot re-enter within it.
         fine = w0 < rate * dt_s * FINE_CHUNKS
@@ -964,10 +940,10 @@ def _propagate(
         if coarse.any():
             # Newton on W(nu) = target, dW/dnu = P; W is convex-ish and smooth, three steps reach 1e-10.
             target = w0[coarse] - rate[coarse] * dt_s
-            nu_new[coarse] = _solve_nu(
-                curves, label[coarse], nu0[coarse], w0[coarse], target, hp_new[coarse], ha_new[coarse]
+            nu_new[coarse] = curves.nu_at_weight(
+                label[coarse], nu0[coarse], w0[coarse], target, hp_new[coarse], ha_new[coarse]
             )
-            hp_new[coarse], ha_new[coarse], _ = _weight_at(curves, label[coarse], nu_new[coarse])
+            hp_new[coarse], ha_new[coarse], _ = curves.weighted_at(label[coarse], nu_new[coarse])
         hp[active], ha[active] = hp_new, ha_new
         keep = ~done
         label, tau = label[keep], np.log1p(nu_new[keep] / NU_REF)

@@ -47,7 +47,7 @@ from orbit_env import cache
 from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
-from orbit_env.physics.orbit import period_s, validate_heights, validate_heights_km
+from orbit_env.physics.orbit import elements_from_heights, period_s, validate_heights, validate_heights_km
 
 FloatArray = NDArray[np.float64]
 
@@ -788,6 +788,34 @@ class UniversalCurves:
             return self._at_scalar(float(label), float(tau))
         mu = np.asarray(label, dtype=np.float64)
         return _heights(mu, *self.table_b.values(mu, tau))
+
+    def weighted_at(self, label: ArrayLike, nu: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Perigee height [m], apogee height [m] and W = Int P dnu left at (label, nu)."""
+        nu = np.asarray(nu, dtype=np.float64)
+        hp, ha, q = self.at(label, np.log1p(nu / NU_REF))
+        return hp, ha, q * nu
+
+    def nu_at_weight(
+        self,
+        label: ArrayLike,
+        nu: ArrayLike,
+        weighted: ArrayLike,
+        target: ArrayLike,
+        perigee_m: ArrayLike,
+        apogee_m: ArrayLike,
+    ) -> FloatArray:
+        """The nu at which W falls to ``target`` along each curve, from nu (where W is ``weighted``, at those heights).
+
+        Newton's method on W(nu) = target with dW/dnu = P, the period at each iterate (four
+        steps: the table's own precision). Never below 0 (re-entry).
+        """
+        p_now, e_now = elements_from_heights(perigee_m, apogee_m)
+        nu = np.maximum(np.asarray(nu, dtype=np.float64) - (weighted - target) / period_s(p_now, e_now), 0.0)
+        for _ in range(3):
+            hp_k, ha_k, w = self.weighted_at(label, nu)
+            p_k, e_k = elements_from_heights(hp_k, ha_k)
+            nu = np.maximum(nu - (w - target) / period_s(p_k, e_k), 0.0)
+        return nu
 
     def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
         """`at` for one orbit, in plain floats (the arithmetic of `_heights`)."""

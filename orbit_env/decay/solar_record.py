@@ -265,6 +265,11 @@ def load_record() -> RecordActivity:
     return _load(str(user) if user.is_file() else str(SHIPPED_RECORD))
 
 
+def shipped_record() -> RecordActivity:
+    """The record shipped with the package, whatever a user imported (what a benchmark task steps on)."""
+    return _load(str(SHIPPED_RECORD))
+
+
 @lru_cache(maxsize=4)
 def _load(path: str) -> RecordActivity:
     """`read_record`, its arrays kept in the disk cache per file, size and time (parsing takes 0.2 s a process)."""

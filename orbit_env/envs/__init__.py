@@ -5,11 +5,12 @@
 | ``OrbitRaising-v0``           | Discrete: burn sizes   | the paper's, known                        |
 | ``OrbitRaisingContinuous-v0`` | Box [-1, 1]: burn size | the paper's, known                        |
 | ``OrbitRaisingUncertain-v0``  | Discrete: burn sizes   | scale drawn per episode, hidden, drifting |
+| ``OrbitRaisingSolar-v0``      | Discrete: burn sizes   | NRLMSIS under the real Sun; disposal rule |
 
 Each has a single environment (``gymnasium.make``) and a numpy-batched vector
 environment (``gymnasium.make_vec(id, num_envs=N)``, autoreset ``NEXT_STEP`` by default);
 `orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
-is the docstring of `OrbitRaisingEnv`.
+is the docstring of `OrbitRaisingEnv` (of `OrbitRaisingSolarEnv` for the solar task).
 """
 
 from __future__ import annotations
@@ -18,8 +19,17 @@ import gymnasium
 
 from orbit_env.envs.config import UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
 from orbit_env.envs.orbit_raising import OrbitRaisingEnv
+from orbit_env.envs.solar import OrbitRaisingSolarEnv
 
-__all__ = ["ENV_IDS", "DensityConfig", "OrbitRaisingConfig", "OrbitRaisingEnv", "register_envs"]
+__all__ = [
+    "ENV_IDS",
+    "SOLAR_ENV_ID",
+    "DensityConfig",
+    "OrbitRaisingConfig",
+    "OrbitRaisingEnv",
+    "OrbitRaisingSolarEnv",
+    "register_envs",
+]
 
 _ENTRY_POINT = "orbit_env.envs.orbit_raising:OrbitRaisingEnv"
 _VECTOR_ENTRY_POINT = "orbit_env.envs.vector:OrbitRaisingVectorEnv"
@@ -30,6 +40,10 @@ _VARIANTS: dict[str, dict[str, object]] = {
     "OrbitRaisingContinuous-v0": {"continuous": True},
     "OrbitRaisingUncertain-v0": {"density": UNCERTAIN_DENSITY},
 }
+#: The solar decision task's id (its own task model, `orbit_env.envs.solar_task`).
+SOLAR_ENV_ID = "OrbitRaisingSolar-v0"
+_SOLAR_ENTRY_POINTS = ("orbit_env.envs.solar:OrbitRaisingSolarEnv", "orbit_env.envs.solar:OrbitRaisingSolarVectorEnv")
+#: The ids of the known-density family (one task model, `orbit_env.envs.task`).
 ENV_IDS = tuple(_VARIANTS)
 
 
@@ -40,12 +54,14 @@ def register_envs() -> None:
     ``horizon_steps`` (a flat keyword of ``gymnasium.make``), the one owner of the
     truncation and of the observed clock.
     """
-    for env_id, kwargs in _VARIANTS.items():
+    entry_points = {env_id: (_ENTRY_POINT, _VECTOR_ENTRY_POINT) for env_id in _VARIANTS}
+    entry_points[SOLAR_ENV_ID] = _SOLAR_ENTRY_POINTS
+    for env_id, (entry_point, vector_entry_point) in entry_points.items():
         if env_id in gymnasium.registry:
             continue
         gymnasium.register(
             id=env_id,
-            entry_point=_ENTRY_POINT,
-            vector_entry_point=_VECTOR_ENTRY_POINT,
-            kwargs=dict(kwargs),
+            entry_point=entry_point,
+            vector_entry_point=vector_entry_point,
+            kwargs=dict(_VARIANTS.get(env_id, {})),
         )

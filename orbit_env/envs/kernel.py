@@ -8,7 +8,9 @@ whatever its size; `coast_and_observe` coasts every satellite and computes its r
 episode end and observation in three loops, with numpy's SIMD ``exp`` and ``log1p``
 between them (the C library's, one number at a time in a loop, cost twice as much).
 The formulas are `orbit_env.envs.task`'s, in the same order, on the same state array and
-the same tables of the universal curves (`orbit_env.decay.curves`).
+the same tables of the universal curves (`orbit_env.decay.curves`). The solar task
+(`orbit_env.envs.solar_task`) burns through `burn_rows` too, on its own curves; its month of
+decay by the drag clock is numpy's.
 
 The contract with the task model is declared once: the state's rows are
 `orbit_env.envs.state.ROW`, the task's numbers `KernelParameters`, a table's scales

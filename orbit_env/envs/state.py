@@ -41,6 +41,7 @@ class StateFields(NamedTuple):
     dv_left_m_s: int  # delta-v the propellant on board still gives [m/s]
     time_days: int  # mission time [days]
     steps: int  # steps taken (whole numbers, exact in float64)
+    start_day: int  # the solar task's first day of the mission, days since its record's first (else 0)
 
 
 #: The names of the fields, in the order of a batch's rows.

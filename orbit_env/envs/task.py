@@ -351,7 +351,7 @@ def start_and_options(
     state.drag_area_m2 = values["drag_coefficient"] * values["area_m2"]
     state.density_base = values["density_scale"]
     state.density_phase_rad = values["density_phase_rad"]
-    state.time_days = state.steps = 0.0
+    state.time_days = state.steps = state.start_day = 0.0
     state.perigee_drop_m = state.apogee_drop_m = 0.0
     update_satellite(task, state)
     if "curve_label" in values:
@@ -384,7 +384,7 @@ def _satellite_states(task: Task, dv_left_m_s: ArrayLike, steps: ArrayLike, size
     state.mass_kg = mass_from_delta_v_left_kg(dv_left_m_s, config.dry_mass_kg, config.exhaust_velocity_m_s)
     state.drag_area_m2 = config.drag_coefficient * config.area_m2
     state.density_base = task.density.nominal_scale
-    state.density_phase_rad = state.time_days = 0.0
+    state.density_phase_rad = state.time_days = state.start_day = 0.0
     state.steps = steps
     state.perigee_drop_m = state.apogee_drop_m = 0.0
     update_satellite(task, state)

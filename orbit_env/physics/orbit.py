@@ -95,6 +95,18 @@ def perigee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArra
     return np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
 
 
+def apogee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
+    """Speed at apogee, v_a = sqrt(2 fM r_p / (r_a (r_p + r_a))) (vis-viva) [m/s]."""
+    rp = np.add(perigee_m, EARTH_RADIUS_M)
+    ra = np.add(apogee_m, EARTH_RADIUS_M)
+    return np.sqrt(2.0 * MU_EARTH_M3_S2 * rp / (ra * (rp + ra)))
+
+
+def dv_to_lower_perigee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, new_perigee_m: ArrayLike) -> FloatArray:
+    """Retrograde burn at apogee [m/s] that lowers the perigee to ``new_perigee_m`` (the apogee stays; vis-viva)."""
+    return apogee_velocity_m_s(perigee_m, apogee_m) - apogee_velocity_m_s(new_perigee_m, apogee_m)
+
+
 def apogee_after_perigee_burn_m(perigee_m: ArrayLike, apogee_m: ArrayLike, dv_m_s: ArrayLike) -> FloatArray:
     """Apogee height [m] after a tangential burn of ``dv_m_s`` at perigee (exact vis-viva).
 

@@ -1,0 +1,358 @@
+"""Yardsticks of the solar task (``OrbitRaisingSolar-v0``): operators' rules, the optimum, the evaluation.
+
+Hand-coded operators' rules act on the observation alone, as an operator would
+(`SOLAR_HAND_CODED`): never burn; burn the whole tank at once; reboost when the perigee falls
+below a threshold; reboost when the predicted lifetime falls below a share of the mission's
+time left; the greedy look-ahead on the observed activity held constant. The two thresholds
+are tuned on the train split (`tune`), never on the test split. The optimum is the per-episode
+DP (`orbit_env.agents.solar_dp`), which knows the Sun's future.
+
+`evaluate_solar` scores them all on the same missions (drawn once from a seed; the DP's
+episodes solved and flown in worker processes), as ``orbit-env evaluate --env
+OrbitRaisingSolar-v0`` prints them.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from orbit_env.agents.evaluate import Episodes
+from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.envs import solar_task
+from orbit_env.envs import task as task_model
+from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SolarMission, SolarTask
+from orbit_env.envs.state import BatchState
+from orbit_env.envs.task import DV_SCALE_M_S, HEIGHT_SCALE_M, LIFETIME_SCALE_DAYS
+from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
+
+FloatArray = NDArray[np.float64]
+
+#: Seed of the tuning missions on the train split (the evaluation's is `orbit_env.agents.evaluate.EVAL_SEED`).
+TUNE_SEED = 777
+#: Missions the thresholds are tuned on.
+TUNE_EPISODES = 300
+#: Perigee thresholds tried [km] and delta-v reserves kept for the disposal [m/s].
+PERIGEE_THRESHOLDS_KM = tuple(range(200, 451, 25))
+RESERVES_M_S = (0.0, 20.0, 40.0)
+#: Shares of the mission's time left below which a predicted lifetime triggers a reboost.
+LIFE_SHARES = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 3.0)
+#: Bisection steps of the greedy rule's disposal estimate (400 km / 2^20: well under a metre).
+GREEDY_BISECTIONS = 20
+
+
+def _largest(task: SolarTask) -> int:
+    return len(task.config.burn_sizes_m_s) - 1
+
+
+def _column(obs: FloatArray, name: str) -> FloatArray:
+    return np.asarray(obs, dtype=np.float64)[:, SOLAR_OBS_INDEX[name]]
+
+
+class Never:
+    """Never burn (the disposal burn at the end is the environment's)."""
+
+    def __init__(self, task: SolarTask) -> None:
+        self.task = task
+
+    def actions(self, obs: FloatArray) -> NDArray[np.int64]:
+        """Action 0 for every observation."""
+        return np.zeros(len(obs), dtype=np.int64)
+
+
+class AllAtOnce(Never):
+    """The largest burn at every step from the start until the tank is empty."""
+
+    def actions(self, obs: FloatArray) -> NDArray[np.int64]:
+        """The largest burn size for every observation."""
+        return np.full(len(obs), _largest(self.task), dtype=np.int64)
+
+
+class PerigeeThreshold(Never):
+    """Reboost (the largest burn) when the perigee is below a threshold, keeping a reserve for the disposal."""
+
+    def __init__(self, task: SolarTask, threshold_km: float, reserve_m_s: float) -> None:
+        super().__init__(task)
+        self.threshold_km, self.reserve_m_s = threshold_km, reserve_m_s
+
+    def actions(self, obs: FloatArray) -> NDArray[np.int64]:
+        """The largest burn where the perigee is low and the tank holds more than the reserve."""
+        low = _column(obs, "perigee") * HEIGHT_SCALE_M < self.threshold_km * 1e3
+        spare = _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
+        return np.where(low & spare, _largest(self.task), 0).astype(np.int64)
+
+
+class LifeThreshold(PerigeeThreshold):
+    """Reboost when the predicted lifetime is below ``share`` x the mission's time left, keeping a reserve."""
+
+    def actions(self, obs: FloatArray) -> NDArray[np.int64]:
+        """The largest burn where the predicted life is short of the time left and the tank holds the reserve."""
+        x = np.clip(_column(obs, "predicted_lifetime"), 0.0, 1.0 - 1e-9)
+        life_days = LIFETIME_SCALE_DAYS * x / (1.0 - x)
+        left_days = (1.0 - _column(obs, "mission_clock")) * self.task.mission_days
+        short = life_days < self.threshold_km * left_days  # threshold_km holds the share
+        spare = _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
+        return np.where(short & spare & (left_days > 0.0), _largest(self.task), 0).astype(np.int64)
+
+
+def decode(task: SolarTask, obs: FloatArray) -> BatchState:
+    """The states a ground station recovers from observations: orbit, tank, steps, last month's multiplier."""
+    obs = np.atleast_2d(np.asarray(obs, dtype=np.float64))
+    perigee = np.clip(_column(obs, "perigee") * HEIGHT_SCALE_M, REENTRY_ALTITUDE_M, None)
+    apogee = np.maximum(_column(obs, "apogee") * HEIGHT_SCALE_M, perigee)
+    dv_left = np.maximum(_column(obs, "delta_v_left") * DV_SCALE_M_S, 0.0)
+    steps = np.rint(_column(obs, "mission_clock") * task.config.horizon_steps)
+    label, tau = task.curves.locate_exactly(perigee, apogee)
+    state = task_model.states_on_curves(task, label, tau, dv_left, steps)
+    x = np.clip(_column(obs, "predicted_lifetime"), 1e-9, 1.0 - 1e-9)
+    life_days = LIFETIME_SCALE_DAYS * x / (1.0 - x)
+    gc = solar_task.drag_rate(state)
+    state.density_scale = state.period_s * state.nu / (gc * life_days * SECONDS_PER_DAY)
+    return state
+
+
+class GreedyConstant(Never):
+    """The greedy look-ahead with the observed activity held constant (last month's drag, at the perigee).
+
+    For each burn: burn now, never again; the days in orbit to the mission's end at the last
+    month's multiplier, less the burn's cost, less the disposal this orbit would then need at the
+    same multiplier (or the penalty if the tank could not pay it).
+    """
+
+    def actions(self, obs: FloatArray) -> NDArray[np.int64]:
+        """The burn with the best look-ahead value."""
+        task = self.task
+        state = decode(task, obs)
+        left_days = (task.config.horizon_steps - state.steps) * task.mission.block_days
+        cost = task.config.propellant_cost_per_m_s
+        best = np.full(state.size, -np.inf)
+        choice = np.zeros(state.size, dtype=np.int64)
+        for index, size in enumerate(task.config.burn_sizes_m_s):
+            trial = state.copy()
+            made = task_model.burn(task, trial, np.full(trial.size, size))
+            rate_s = solar_task.drag_rate(trial) * trial.density_scale * SECONDS_PER_DAY  # W per day
+            weighted = trial.period_s * trial.nu
+            life = weighted / rate_s
+            value = np.minimum(life, left_days) - cost * made
+            up = life > left_days
+            if up.any():
+                end = weighted[up] - rate_s[up] * left_days[up]
+                label = trial.label[up]
+                nu = task.curves.nu_at_weight(
+                    label, trial.nu[up], weighted[up], end, trial.perigee_m[up], trial.apogee_m[up]
+                )
+                hp, ha, _ = task.curves.weighted_at(label, nu)
+                allowed = rate_s[up] * task.mission.disposal_days
+                low, high = np.full(hp.shape, REENTRY_ALTITUDE_M), hp.copy()
+                complies = end <= allowed
+                for _ in range(GREEDY_BISECTIONS):
+                    middle = 0.5 * (low + high)
+                    ok = task.curves.locate(middle, ha).weighted_s <= allowed
+                    low, high = np.where(ok, middle, low), np.where(ok, high, middle)
+                need = np.where(complies, 0.0, dv_to_lower_perigee_m_s(hp, ha, low))
+                able = need <= trial.dv_left_m_s[up] + 1e-9
+                value[up] -= np.where(able, cost * need, task.penalty_days)
+            better = value > best + 1e-9
+            best = np.where(better, value, best)
+            choice = np.where(better, index, choice)
+        return choice
+
+
+@dataclass(frozen=True)
+class Flown:
+    """Missions flown by one policy (arrays over the missions)."""
+
+    returns: FloatArray
+    days_in_orbit: FloatArray
+    dv_m_s: FloatArray  # perigee burns and the disposal burn
+    disposal_m_s: FloatArray
+    complies: NDArray[np.bool_]
+    reentered: NDArray[np.bool_]
+
+    def episodes(self) -> Episodes:
+        """As `orbit_env.agents.evaluate.Episodes` (its summary and paired differences)."""
+        return Episodes(returns=self.returns, lifetime_days=self.days_in_orbit, dv_m_s=self.dv_m_s)
+
+
+def starts(task: SolarTask, episodes: int, seed: int) -> dict[str, FloatArray]:
+    """The start options of ``episodes`` missions drawn from the task's split with ``seed``."""
+    return solar_task.start_options(solar_task.start(task, np.random.default_rng(seed), episodes))
+
+
+def fly(task: SolarTask, options: Mapping[str, Any], act: Callable[[BatchState], FloatArray]) -> Flown:
+    """Fly the missions of ``options`` with ``act`` (states -> burns requested [m/s]) to their ends."""
+    n = len(options["start_day"])
+    state = solar_task.start(task, np.random.default_rng(0), n, options)
+    total, dv, disposal = np.zeros(n), np.zeros(n), np.zeros(n)
+    complies, reentered = np.ones(n, dtype=bool), np.zeros(n, dtype=bool)
+    running = np.ones(n, dtype=bool)
+    while running.any():
+        rows = np.flatnonzero(running)
+        sub = state.take(rows)
+        result = solar_task.step(task, sub, act(sub))
+        state.put(rows, sub)
+        total[rows] += result.reward
+        dv[rows] += result.burn_m_s + result.disposal_m_s
+        disposal[rows] += result.disposal_m_s
+        complies[rows] &= result.complies
+        reentered[rows] |= result.terminated
+        running[rows] = ~(result.terminated | result.truncated)
+    return Flown(total, state.time_days.copy(), dv, disposal, complies, reentered)
+
+
+def by_observation(task: SolarTask, policy: Never) -> Callable[[BatchState], FloatArray]:
+    """An observation policy as `fly`'s ``act``: it sees `orbit_env.envs.solar_task.observe`, no more."""
+    sizes = np.array(task.config.burn_sizes_m_s)
+    return lambda state: sizes[policy.actions(solar_task.observe(task, state))]
+
+
+@lru_cache(maxsize=4)
+def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
+    """The thresholds (and reserves) of the two threshold rules that do best on the train split.
+
+    Each candidate flies the same `TUNE_EPISODES` missions of the train split (seed `TUNE_SEED`),
+    whatever split ``task`` is on.
+    """
+    train = SolarTask(config=task.config, mission=_with_split(task.mission, "train"))
+    options = starts(train, TUNE_EPISODES, TUNE_SEED)
+    best: dict[str, tuple[float, float]] = {}
+    for name, cls, grid in (
+        ("perigee_threshold", PerigeeThreshold, PERIGEE_THRESHOLDS_KM),
+        ("life_threshold", LifeThreshold, LIFE_SHARES),
+    ):
+        scores = {
+            (float(x), reserve): fly(train, options, by_observation(train, cls(train, x, reserve))).returns.mean()
+            for x in grid
+            for reserve in RESERVES_M_S
+        }
+        best[name] = max(scores, key=lambda key: scores[key])
+    return best
+
+
+def _with_split(mission: SolarMission, split: str) -> SolarMission:
+    from dataclasses import replace
+
+    return replace(mission, solar_split=split)
+
+
+def hand_coded(task: SolarTask) -> dict[str, Never]:
+    """The operators' rules, the thresholds tuned on the train split (`tune`)."""
+    tuned = tune(task)
+    return {
+        "never": Never(task),
+        "all_at_once": AllAtOnce(task),
+        "perigee_threshold": PerigeeThreshold(task, *tuned["perigee_threshold"]),
+        "life_threshold": LifeThreshold(task, *tuned["life_threshold"]),
+        "greedy_constant": GreedyConstant(task),
+    }
+
+
+#: The order of the rows: the hand-coded rules, then the optimum.
+SOLAR_HAND_CODED = ("never", "all_at_once", "perigee_threshold", "life_threshold", "greedy_constant")
+
+
+def _fly_dp(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, float, float, bool, bool, float]:
+    """Solve one mission's DP and fly its policy (in a worker: the DP's tables stay there)."""
+    from orbit_env.agents.solar_dp import SolarDP
+
+    task, option = job
+    options = {k: np.array([v]) for k, v in option.items()}
+    dp = SolarDP(task, option["start_day"])
+    flown = fly(task, options, dp.burns_m_s)
+    start = solar_task.start(task, np.random.default_rng(0), 1, options)
+    return (
+        float(flown.returns[0]),
+        float(flown.days_in_orbit[0]),
+        float(flown.dv_m_s[0]),
+        float(flown.disposal_m_s[0]),
+        bool(flown.complies[0]),
+        bool(flown.reentered[0]),
+        float(dp.value(start)[0]),
+    )
+
+
+@dataclass(frozen=True)
+class SolarEvaluation:
+    """Every policy on the same missions, and the optimum's estimate of itself."""
+
+    flown: dict[str, Flown]
+    dp_estimate: FloatArray  # V_0 of the DP's grid at each start (the certificate's other side)
+    tuned: dict[str, tuple[float, float]]
+
+
+def evaluate_solar(
+    episodes: int,
+    seed: int,
+    *,
+    solar_split: str = "test",
+    disposal_years: float = 5.0,
+    include_dp: bool = True,
+    workers: int | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> SolarEvaluation:
+    """Fly every hand-coded rule and the optimum on ``episodes`` missions of the split (drawn with ``seed``)."""
+    task = SolarTask(mission=SolarMission(solar_split=solar_split, disposal_years=disposal_years))
+    options = starts(task, episodes, seed)
+    say = progress or (lambda _: None)
+    say("tuning the thresholds on the train split")
+    policies = hand_coded(task)
+    flown = {}
+    for name in SOLAR_HAND_CODED:
+        say(name)
+        flown[name] = fly(task, options, by_observation(task, policies[name]))
+    estimate = np.full(episodes, np.nan)
+    if include_dp:
+        say(f"dp ({episodes} missions, one DP each)")
+        jobs = [(task, {k: float(v[i]) for k, v in options.items()}) for i in range(episodes)]
+        count = workers or min(os.cpu_count() or 1, 8)
+        if count > 1 and episodes > 1:
+            with ProcessPoolExecutor(count) as pool:
+                rows = list(pool.map(_fly_dp, jobs))
+        else:
+            rows = [_fly_dp(job) for job in jobs]
+        columns = list(zip(*rows, strict=True))
+        flown["dp"] = Flown(
+            np.array(columns[0]),
+            np.array(columns[1]),
+            np.array(columns[2]),
+            np.array(columns[3]),
+            np.array(columns[4]),
+            np.array(columns[5]),
+        )
+        estimate = np.array(columns[6])
+    return SolarEvaluation(flown, estimate, dict(tune(task)))
+
+
+def solar_report(evaluation: SolarEvaluation) -> dict[str, Any]:
+    """What the solar evaluation adds to the table: the rule's shares per policy, the tuning, the certificate."""
+    report: dict[str, Any] = {
+        "policies": {
+            name: {
+                "disposal_share": float((flown.disposal_m_s > 0.0).mean()),
+                "noncompliant_share": float((~flown.complies).mean()),
+                "reentered_share": float(flown.reentered.mean()),
+                "mean_disposal_m_s": float(flown.disposal_m_s.mean()),
+            }
+            for name, flown in evaluation.flown.items()
+        },
+        "tuned": {name: list(values) for name, values in evaluation.tuned.items()},
+    }
+    if "dp" in evaluation.flown:
+        dp = evaluation.flown["dp"].returns
+        gap = evaluation.dp_estimate - dp
+        rules = np.max([evaluation.flown[name].returns for name in SOLAR_HAND_CODED], axis=0)
+        report["rule_binds_share"] = report["policies"]["dp"]["disposal_share"]
+        report["certificate"] = {
+            "mean_gap_days": float(gap.mean()),
+            "max_gap_days": float(gap.max()),
+            "beaten_by_a_rule": int(np.sum(rules > dp + 1e-6)),
+            "largest_rule_lead_days": float(np.max(rules - dp)),
+        }
+    return report

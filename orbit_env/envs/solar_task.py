@@ -1,0 +1,539 @@
+"""The solar decision task: when to raise the apogee under the real Sun, with the disposal rule at the end.
+
+A satellite of today (53 deg, NRLMSIS 2.1 in co-rotating air, the shipped space-weather
+record) flies a five-year mission from a date drawn from its split of the record. Each step
+is a month (`SolarMission.block_days`); at its start the agent may fire at perigee, which
+raises the apogee and keeps the perigee low (the paper's burn); the orbit then decays along
+the universal curves of a reference NRLMSIS profile by the drag clock of that month at its
+perigee (`orbit_env.decay.drag_clock`). At the mission's end the orbit must comply with the
+disposal rule: re-enter within ``disposal_years`` under the record's Sun after the end. The
+task then makes the cheapest compliant disposal burn (retrograde at apogee, lowering the
+perigee) and charges its propellant; where the propellant left cannot make the orbit comply,
+it charges `SolarTask.penalty_days` instead.
+
+The parts it shares with the known-density task (`orbit_env.envs.task`): the state's fields
+and storage (`orbit_env.envs.state`), the perigee burn (`orbit_env.envs.task.burn`: the rocket
+equation, the vis-viva burn, the move to the new curve) and the universal curves. What is its
+own: the calendar (a mission's days are whole days of the record), the drag clock's coast, the
+observation of the Sun, and the disposal rule. Every consumer (the single and the vector
+environment, the hand-coded policies, the DP) calls these functions; the manual is
+`orbit_env.envs.solar.OrbitRaisingSolarEnv`'s docstring and docs/solar-task.md.
+
+SI units inside (m, kg, s, m/s); days for the calendar and the reward; km in the reset options.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from functools import cached_property
+from typing import Any, NamedTuple
+
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from orbit_env.checks import check_number
+from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution
+from orbit_env.decay.drag_clock import DragClock, drag_clock
+from orbit_env.decay.solar import iso_date, unix_days
+from orbit_env.envs.config import OrbitRaisingConfig
+from orbit_env.envs.state import STALE_SEGMENT, BatchState
+from orbit_env.envs.task import (
+    APOGEE_DROP_SCALE_M,
+    DV_SCALE_M_S,
+    HEIGHT_SCALE_M,
+    LIFETIME_SCALE_DAYS,
+    OBS_NAMES,
+    PERIGEE_DROP_SCALE_M,
+    Task,
+    burn,
+    place,
+    update_satellite,
+)
+from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
+
+FloatArray = NDArray[np.float64]
+
+#: The day that splits the record: training missions end before it (solar cycles 19-23), test missions
+#: begin on or after it (cycles 24-25, held out).
+SPLIT_DATE = "2009-01-01"
+#: The splits of the record a mission's start is drawn from.
+SOLAR_SPLITS = ("train", "test")
+#: Days of the record a mission's first day needs before it: the observation's trailing 365-day mean.
+HISTORY_DAYS = 365
+#: Candidate perigees of the disposal burn per pass (from 100 km to the perigee; two passes, the second
+#: between the last compliant candidate and the next: the cheapest compliant burn to within
+#: (h_p - 100 km) / CANDIDATES^2, under 0.5 km of perigee, about 0.15 m/s).
+DISPOSAL_CANDIDATES = 24
+
+#: The satellite and the mission of ``OrbitRaisingSolar-v0`` (why each, measured: docs/solar-task.md).
+#: A 210 kg smallsat of 1 m^2 (G/(c_x F) = 95 kg/m^2), a monopropellant tank of 10 kg (Isp 220 s:
+#: 105 m/s), burns of 5-20 m/s a month, 61 months (1830 days, five years: half a solar cycle,
+#: so the phase matters), released in near-circular orbits of 380-560 km (where ride-shares drop
+#: satellites of today: without burns about half re-enter within the mission and a fifth to a
+#: third need a disposal burn at its end). Propellant costs 3 days of mission per m/s (the tank
+#: is worth a sixth of the mission: spent on a reboost it is not there for the disposal); at
+#: 1 day per m/s the tuned life-threshold rule captured 93.6% of the optimum's gain on 40 test
+#: missions, at 3 days 81.4%. ``revolutions_per_step`` is unused: a step is
+#: `SolarMission.block_days` of the calendar.
+SOLAR_CONFIG = OrbitRaisingConfig(
+    drag_coefficient=2.2,
+    area_m2=1.0,
+    dry_mass_kg=200.0,
+    propellant_mass_kg=10.0,
+    isp_s=220.0,
+    burn_sizes_m_s=(0.0, 5.0, 10.0, 20.0),
+    max_burn_m_s=20.0,
+    horizon_steps=61,
+    propellant_cost_per_m_s=3.0,
+    start_perigee_km=(380.0, 560.0),
+    start_apogee_max_km=580.0,
+)
+
+#: The observation's components: the known-density task's seven, then the Sun as observed the day before.
+SOLAR_OBS_NAMES = (*OBS_NAMES, "f107", "f107_mean_81d", "f107_mean_365d", "ap")
+#: Index of each component by name.
+SOLAR_OBS_INDEX = {name: i for i, name in enumerate(SOLAR_OBS_NAMES)}
+#: The solar indices are observed in units of 100 (F10.7 in sfu, Ap).
+SOLAR_INDEX_SCALE = 100.0
+SOLAR_OBS_LOW = np.zeros(len(SOLAR_OBS_NAMES), dtype=np.float32)
+SOLAR_OBS_HIGH = np.array([1.2, 5.0, 3.0, 1.0, 1.0, 1.0, 1.0, 5.0, 5.0, 5.0, 5.0], dtype=np.float32)
+
+
+@dataclass(frozen=True)
+class SolarMission:
+    """What makes the orbit-raising task a task of today: the calendar, the Sun's split, the rule.
+
+    Args:
+        solar_split: ``"train"`` (missions wholly before `SPLIT_DATE`: cycles 19-23) or ``"test"``
+            (missions wholly from it, within the observed record: cycles 24-25).
+        disposal_years: The rule: re-enter within this many years of the mission's end (5: the FCC's
+            rule of 2022 for low orbits; 25: the IADC guideline).
+        block_days: Days of a step (30: a month, an operator's planning cycle).
+        inclination_deg: The orbit's inclination (53 deg: the most populated shell of today).
+        start_span_km: A start's apogee lies up to this far above its perigee (uniform).
+    """
+
+    solar_split: str = "train"
+    disposal_years: float = 5.0
+    block_days: int = 30
+    inclination_deg: float = 53.0
+    start_span_km: float = 20.0
+
+    def __post_init__(self) -> None:
+        if self.solar_split not in SOLAR_SPLITS:
+            raise ValueError(f"solar_split={self.solar_split!r} is invalid; allowed: {', '.join(SOLAR_SPLITS)}")
+        check_number(self.disposal_years, "disposal_years", unit="years", low=0.5, high=25.0)
+        if not (isinstance(self.block_days, (int, np.integer)) and 1 <= self.block_days <= 365):
+            raise ValueError(f"block_days={self.block_days!r} is invalid; allowed: a whole number of days in [1, 365]")
+        check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
+        check_number(self.start_span_km, "start_span_km", unit="km", low=0.0, high=500.0)
+
+    @property
+    def disposal_days(self) -> float:
+        """The rule's time from the mission's end to re-entry, at most [days] (365.25-day years)."""
+        return self.disposal_years * 365.25
+
+
+@dataclass(frozen=True)
+class SolarTask(Task):
+    """The solar decision task's parameters: the satellite (``config``), the mission and the rule (``mission``).
+
+    ``density`` and ``continuous`` are the known-density task's; the density is the drag
+    clock's (`orbit_env.decay.drag_clock`), so ``density`` stays the default (scale 1).
+    """
+
+    config: OrbitRaisingConfig = field(default_factory=lambda: SOLAR_CONFIG)
+    mission: SolarMission = field(default_factory=SolarMission)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not isinstance(self.mission, SolarMission):
+            raise ValueError(f"mission={self.mission!r} is invalid; allowed: a SolarMission")
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @cached_property
+    def clock(self) -> DragClock:
+        """The drag clock of the mission's orbit plane."""
+        return drag_clock(self.mission.inclination_deg)
+
+    @cached_property
+    def curves(self) -> UniversalCurves:  # type: ignore[override]
+        """The universal curves of the drag clock's reference NRLMSIS profile."""
+        return self.clock.curves
+
+    @property
+    def mission_days(self) -> int:
+        """The mission's length [days]."""
+        return self.config.horizon_steps * self.mission.block_days
+
+    @cached_property
+    def penalty_days(self) -> float:
+        """What an orbit that cannot comply at the end costs [days].
+
+        The mission's days plus the cost of the whole tank: a non-compliant plan then returns at
+        most minus the tank's cost, and a compliant one (save the tank, dispose at the end: always
+        possible from the start distribution, `start_window` checks the worst) at least that.
+        """
+        return self.mission_days + self.config.propellant_cost_per_m_s * self.config.delta_v_capacity_m_s
+
+    @cached_property
+    def start_window(self) -> tuple[int, int]:
+        """The first and the last clock day a mission of the split may start on."""
+        clock, mission = self.clock, self.mission
+        split = clock.day_of(unix_days(SPLIT_DATE))
+        if mission.solar_split == "train":
+            first, last = HISTORY_DAYS, split - self.mission_days
+        else:
+            first, last = split, clock.day_of(clock.record.observed_end_days) + 1 - self.mission_days
+        judged_to = last + self.mission_days + math.ceil(mission.disposal_days) + mission.block_days
+        if last < first or judged_to > clock.days:
+            raise ValueError(
+                f"a mission of {self.mission_days} days judged over {mission.disposal_years} years does not fit the "
+                f"{mission.solar_split} split of the record ({iso_date(clock.start_days)} to "
+                f"{iso_date(clock.start_days + clock.days)})"
+            )
+        return first, last
+
+    @property
+    def observation_space(self) -> spaces.Box:
+        """Box of the 11 components of `SOLAR_OBS_NAMES`."""
+        return spaces.Box(SOLAR_OBS_LOW, SOLAR_OBS_HIGH, dtype=np.float32)
+
+
+class SolarStep(NamedTuple):
+    """What `step` returns besides the updated state (arrays over the batch)."""
+
+    reward: FloatArray  # days in orbit minus the propellant's cost, the disposal's and the penalty [days]
+    terminated: NDArray[np.bool_]  # re-entered during the mission
+    truncated: NDArray[np.bool_]  # the mission's end reached (the rule judged)
+    burn_m_s: FloatArray  # the perigee burn made [m/s]
+    disposal_m_s: FloatArray  # the disposal burn made at the end [m/s] (0 elsewhere)
+    complies: NDArray[np.bool_]  # at the end: the orbit complies (after its disposal burn); True elsewhere
+
+
+# ---------------------------------------------------------------------------------
+# Start.
+# ---------------------------------------------------------------------------------
+
+#: Reset options of the solar task: pinned starts (any subset) or the exact replay of one.
+SOLAR_START_OPTIONS = ("perigee_km", "apogee_km", "start_date", "start_day", "curve_label", "curve_tau")
+
+
+def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping[str, Any] | None = None) -> BatchState:
+    """New missions: start day, orbit drawn from the split and the config, pinned where ``options`` say.
+
+    Options (numbers or arrays of shape (size,)): ``perigee_km``, ``apogee_km``, ``start_date``
+    (ISO date) or ``start_day`` (days since the record's first); ``curve_label`` with
+    ``curve_tau`` put the orbit at that point of the curves (the exact replay of a start, as
+    `start_options` reports it).
+
+    Raises:
+        ValueError: an unknown option, or a start outside the split or the curves' domain.
+    """
+    options = dict(options or {})
+    unknown = set(options) - set(SOLAR_START_OPTIONS)
+    if unknown:
+        raise ValueError(f"unknown reset option(s) {sorted(unknown)}; allowed: {', '.join(SOLAR_START_OPTIONS)}")
+    config, mission = task.config, task.mission
+    first, last = task.start_window
+    day = rng.integers(first, last + 1, size).astype(np.float64)
+    low_km, high_km = config.start_perigee_km
+    perigee_km = rng.uniform(low_km, high_km, size)
+    apogee_km = perigee_km + rng.uniform(0.0, mission.start_span_km, size)
+    if "start_date" in options:
+        options["start_day"] = np.vectorize(lambda d: task.clock.day_of(unix_days(str(d))))(options.pop("start_date"))
+    if "start_day" in options:
+        day = np.broadcast_to(np.asarray(options["start_day"], dtype=np.float64), (size,)).copy()
+        if not np.all((day == np.round(day)) & (day >= first) & (day <= last)):
+            raise ValueError(
+                f"start_day={options['start_day']!r} is invalid; allowed: whole days in [{first}, {last}] "
+                f"({iso_date(task.clock.start_days + first)} to {iso_date(task.clock.start_days + last)}, "
+                f"the {mission.solar_split} split)"
+            )
+    perigee_km = np.broadcast_to(np.asarray(options.get("perigee_km", perigee_km), dtype=np.float64), (size,))
+    apogee_km = np.broadcast_to(np.asarray(options.get("apogee_km", apogee_km), dtype=np.float64), (size,))
+    task.curves.check_domain_km(perigee_km, apogee_km)
+    state = BatchState(size)
+    state.dry_mass_kg = config.dry_mass_kg
+    state.mass_kg = config.wet_mass_kg
+    state.exhaust_m_s = config.exhaust_velocity_m_s
+    state.drag_area_m2 = config.drag_coefficient * config.area_m2
+    state.density_base = 1.0
+    state.density_phase_rad = state.time_days = state.steps = 0.0
+    state.perigee_drop_m = state.apogee_drop_m = 0.0
+    state.start_day = day
+    update_satellite(task, state)
+    if "curve_label" in options or "curve_tau" in options:
+        label = np.broadcast_to(np.asarray(options["curve_label"], dtype=np.float64), (size,))
+        tau = np.broadcast_to(np.asarray(options["curve_tau"], dtype=np.float64), (size,))
+        hp, ha, period = task.curves.at(label, tau)
+        state.label, state.tau, state.period_s = label, tau, period
+        state.nu = NU_REF * np.expm1(tau)
+        state.perigee_m, state.apogee_m = hp, ha
+        state.segments[0] = STALE_SEGMENT
+    else:
+        place(task, state, perigee_km * 1e3, apogee_km * 1e3)
+    # The multiplier observed over the month before the start.
+    state.density_scale = task.clock.drag_days(state.perigee_m, day - task.mission.block_days, day) / (
+        task.mission.block_days
+    )
+    return state
+
+
+def start_options(state: BatchState) -> dict[str, FloatArray]:
+    """The options that give these missions' starts back exactly (their point on the curves and day)."""
+    return {
+        "curve_label": state.label.copy(),
+        "curve_tau": state.tau.copy(),
+        "start_day": state.start_day.copy(),
+    }
+
+
+# ---------------------------------------------------------------------------------
+# Step.
+# ---------------------------------------------------------------------------------
+
+
+def today(task: SolarTask, state: BatchState) -> FloatArray:
+    """Each mission's current clock day (its next step's first)."""
+    return state.start_day + state.steps * task.mission.block_days
+
+
+def drag_rate(state: BatchState) -> FloatArray:
+    """The rate g c of each satellite: W falls by g c times the drag clock [s] (Eq. 4.1)."""
+    return nu_per_revolution(state.drag_area_m2 / state.mass_kg, 1.0)
+
+
+def coast_block(
+    clock: DragClock,
+    curves: UniversalCurves,
+    label: FloatArray,
+    nu: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    gc: FloatArray,
+    first_day: FloatArray,
+    days: float,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Decay orbits over ``days`` days from ``first_day`` (whole days) at the drag clock of their perigee.
+
+    W = Int P dnu falls by g c x the drag-days of the span at the perigee of its start; an orbit
+    whose W runs out re-enters at that fraction of the span (the span's mean rate).
+
+    Returns:
+        (days lived in the span, nu, perigee, apogee after it, the span's mean multiplier).
+    """
+    _, _, weighted = curves.weighted_at(label, nu)
+    drag = clock.drag_days(perigee_m, first_day, first_day + math.ceil(days)) * (days / math.ceil(days))
+    drop = gc * drag * SECONDS_PER_DAY
+    target = weighted - drop
+    lived = np.where(target > 0.0, days, days * weighted / np.maximum(drop, 1e-300))
+    new_nu = np.where(
+        target > 0.0, curves.nu_at_weight(label, nu, weighted, np.maximum(target, 0.0), perigee_m, apogee_m), 0.0
+    )
+    hp, ha, _ = curves.weighted_at(label, new_nu)
+    return lived, new_nu, hp, ha, drag / days
+
+
+def coast(task: SolarTask, state: BatchState) -> FloatArray:
+    """One step's decay (`coast_block` over `SolarMission.block_days`), in place; return the days lived."""
+    block = task.mission.block_days
+    lived, nu, hp, ha, ratio = coast_block(
+        task.clock,
+        task.curves,
+        state.label,
+        state.nu,
+        state.perigee_m,
+        state.apogee_m,
+        drag_rate(state),
+        today(task, state),
+        float(block),
+    )
+    state.perigee_drop_m = state.perigee_m - hp
+    state.apogee_drop_m = state.apogee_m - ha
+    state.nu = nu
+    state.tau = np.log1p(nu / NU_REF)
+    state.perigee_m, state.apogee_m = hp, ha
+    state.period_s = np.where(nu > 0.0, task.curves.at(state.label, state.tau)[2], state.period_s)
+    state.segments[0] = STALE_SEGMENT
+    state.density_scale = ratio
+    state.time_days += lived
+    state.steps += 1.0
+    return lived
+
+
+def life_margin_days(
+    task: SolarTask,
+    label: FloatArray,
+    nu: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    gc: FloatArray,
+    first_day: FloatArray,
+) -> FloatArray:
+    """Re-entry day after ``first_day`` minus the rule's days: <= 0 complies.
+
+    The orbits decay by `coast_block` in the task's steps up to the rule's end; one still up
+    then gets its W left over its last rate (days it would still live at that rate), > 0.
+    """
+    block = float(task.mission.block_days)
+    horizon = task.mission.disposal_days
+    label, nu, hp, ha, gc, day = (
+        np.array(a, dtype=np.float64) for a in np.broadcast_arrays(label, nu, perigee_m, apogee_m, gc, first_day)
+    )
+    margin = np.full(label.shape, np.nan)
+    t = 0.0
+    alive = np.flatnonzero(nu > 0.0)
+    margin[nu <= 0.0] = -horizon
+    rate = np.zeros(label.shape)
+    while alive.size and t < horizon:
+        span = min(block, horizon - t)
+        lived, nu[alive], hp[alive], ha[alive], ratio = coast_block(
+            task.clock, task.curves, label[alive], nu[alive], hp[alive], ha[alive], gc[alive], day[alive] + t, span
+        )
+        rate[alive] = ratio
+        ended = nu[alive] <= 0.0
+        margin[alive[ended]] = t + lived[ended] - horizon
+        alive = alive[~ended]
+        t += span
+    if alive.size:
+        _, _, weighted = task.curves.weighted_at(label[alive], nu[alive])
+        margin[alive] = weighted / (gc[alive] * np.maximum(rate[alive], 1e-9) * SECONDS_PER_DAY)
+    return margin
+
+
+def disposal(task: SolarTask, state: BatchState) -> tuple[FloatArray, NDArray[np.bool_]]:
+    """The cheapest compliant disposal burn of each orbit at its mission's end, and whether the tank allows it.
+
+    The rule is judged from the day after the mission (`today`) by `life_margin_days`, at the
+    mass before the disposal (its few kilograms of propellant would shorten the life a little:
+    the judgement is on the safe side). The burn is retrograde at apogee and lowers the perigee
+    (`orbit_env.physics.orbit.dv_to_lower_perigee_m_s`); the lowest candidate, 100 km, re-enters
+    at once, so a compliant perigee always exists. Two passes of `DISPOSAL_CANDIDATES` candidate
+    perigees, the second between the last compliant and the next.
+
+    Returns:
+        (the burn [m/s], 0 where the orbit complies as it is; whether the propellant left makes it).
+    """
+    n = state.size
+    label, nu, hp, ha, gc, day = (
+        state.label,
+        state.nu,
+        state.perigee_m,
+        state.apogee_m,
+        drag_rate(state),
+        today(task, state),
+    )
+    margin = life_margin_days(task, label, nu, hp, ha, gc, day)
+    need = np.flatnonzero(margin > 0.0)
+    dv = np.zeros(n)
+    if need.size:
+        k = DISPOSAL_CANDIDATES
+        low = np.full(need.size, REENTRY_ALTITUDE_M)
+        high = hp[need].copy()
+        for _ in range(2):
+            fractions = np.arange(k + 1) / k  # candidate 0 is `low` (compliant), candidate k is `high`
+            candidates = low[:, None] + (high - low)[:, None] * fractions[None, :]
+            ha_c = np.broadcast_to(ha[need, None], candidates.shape)
+            point = task.curves.locate(candidates.ravel(), ha_c.ravel())
+            hp_c, ha_c2, _ = task.curves.at(point.label, point.tau)
+            m = life_margin_days(
+                task,
+                point.label,
+                point.nu,
+                hp_c,
+                ha_c2,
+                np.repeat(gc[need], k + 1),
+                np.repeat(day[need], k + 1),
+            ).reshape(candidates.shape)
+            m[:, 0] = np.minimum(m[:, 0], 0.0)
+            # The last compliant candidate in each row (compliance is monotone in the perigee).
+            last_ok = (k - np.argmax((m <= 0.0)[:, ::-1], axis=1)).clip(0, k - 1)
+            rows = np.arange(need.size)
+            low, high = candidates[rows, last_ok], candidates[rows, last_ok + 1]
+        dv[need] = dv_to_lower_perigee_m_s(hp[need], ha[need], low)
+    able = dv <= state.dv_left_m_s + 1e-9
+    return dv, able
+
+
+def step(task: SolarTask, state: BatchState, requested_dv_m_s: Any) -> SolarStep:
+    """One step of the task, in place: burn at perigee (maybe), decay a month; at the mission's end, the rule.
+
+    Returns:
+        The reward (days in orbit during the step, minus ``propellant_cost_per_m_s`` times the
+        burn, and at the end times the disposal burn, or the penalty), the ends and the burns.
+    """
+    dv = burn(task, state, requested_dv_m_s)
+    days = coast(task, state)
+    cost = task.config.propellant_cost_per_m_s
+    reward = days - cost * dv
+    terminated = state.nu <= 0.0
+    truncated = (state.steps >= task.config.horizon_steps) & ~terminated
+    disposal_m_s = np.zeros(state.size)
+    complies = np.ones(state.size, dtype=bool)
+    ending = np.flatnonzero(truncated)
+    if ending.size:
+        ended = state.take(ending)
+        need, able = disposal(task, ended)
+        made = np.where(able, need, 0.0)
+        ended.mass_kg = ended.mass_kg / np.exp(made / ended.exhaust_m_s)
+        ended.mass_kg = np.maximum(ended.mass_kg, ended.dry_mass_kg)
+        update_satellite(task, ended)
+        state.put(ending, ended)
+        disposal_m_s[ending] = made
+        complies[ending] = able
+        reward[ending] -= cost * made + np.where(able, 0.0, task.penalty_days)
+    return SolarStep(reward, terminated, truncated, dv, disposal_m_s, complies)
+
+
+# ---------------------------------------------------------------------------------
+# Observe.
+# ---------------------------------------------------------------------------------
+
+
+def observe(task: SolarTask, state: BatchState) -> NDArray[np.float32]:
+    """Observations (n, 11) of a batch: the orbit, the tank, the clock, the predicted life, the Sun.
+
+    The Sun as observed up to the day before the step's first day (F10.7, its trailing 81-
+    and 365-day means, Ap); the predicted lifetime is W over the last month's mean multiplier
+    at the perigee (what the orbit's observed decay says), held at the mission's start by the
+    month before it.
+    """
+    f107, f81, f365, ap = task.clock.daily_indices
+    yesterday = (today(task, state) - 1.0).astype(np.intp)
+    gc = drag_rate(state)
+    weighted = state.period_s * state.nu
+    life_days = weighted / (gc * np.maximum(state.density_scale, 1e-9) * SECONDS_PER_DAY)
+    clock = np.minimum(state.steps / task.config.horizon_steps, 1.0)
+    columns = (
+        state.perigee_m / HEIGHT_SCALE_M,
+        state.apogee_m / HEIGHT_SCALE_M,
+        state.dv_left_m_s / DV_SCALE_M_S,
+        clock,
+        life_days / (life_days + LIFETIME_SCALE_DAYS),
+        np.maximum(state.apogee_drop_m, 0.0) / (np.maximum(state.apogee_drop_m, 0.0) + APOGEE_DROP_SCALE_M),
+        np.maximum(state.perigee_drop_m, 0.0) / (np.maximum(state.perigee_drop_m, 0.0) + PERIGEE_DROP_SCALE_M),
+        f107[yesterday] / SOLAR_INDEX_SCALE,
+        f81[yesterday] / SOLAR_INDEX_SCALE,
+        f365[yesterday] / SOLAR_INDEX_SCALE,
+        ap[yesterday] / SOLAR_INDEX_SCALE,
+    )
+    obs = np.array(columns, dtype=np.float32).T
+    return np.clip(obs, SOLAR_OBS_LOW, SOLAR_OBS_HIGH)
+
+
+def date_of(task: SolarTask, day: float) -> str:
+    """ISO date of a clock day."""
+    return iso_date(task.clock.start_days + float(day))
+
+
+def dates_of(task: SolarTask, days: FloatArray) -> NDArray[np.datetime64]:
+    """Dates (numpy ``datetime64[D]``) of clock days: a vector environment's ``info["date"]``."""
+    unix = np.rint(task.clock.start_days + days).astype(np.int64)
+    return np.datetime64("1970-01-01", "D") + unix.astype("timedelta64[D]")
