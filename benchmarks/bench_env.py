@@ -19,6 +19,10 @@ equation and ``locate`` on the curves for that subset, numpy calls whose fixed c
 hardly shrinks with the subset. CartPole has no counterpart of that, so the
 random-action ratio is the one that matters for training.
 
+The solar task (``OrbitRaisingSolar-v0``, issue 28: the same targets) is timed last, on
+fewer steps (``--solar-steps``, ``--solar-vector-steps``; its step is costlier), each run
+in turn with CartPole's on as many steps.
+
 Run: ``python benchmarks/bench_env.py [--steps N] [--vector-steps N] [--repeats R] [--warmup W]``.
 """
 
@@ -33,7 +37,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.envs.classic_control.cartpole import CartPoleVectorEnv
 
-from orbit_env.envs import ENV_IDS, register_envs
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID, register_envs
 
 NUM_ENVS = 4096
 
@@ -98,6 +102,8 @@ def main() -> None:
         help="untimed vector steps first: after about 300 steps the first missions end and restarting "
         "satellites (full tanks) burn every step, the state training runs in",
     )
+    parser.add_argument("--solar-steps", type=int, default=3000, help="single solar-env steps per run")
+    parser.add_argument("--solar-vector-steps", type=int, default=20, help="solar vector-env steps per run")
     args = parser.parse_args()
     register_envs()
     rng = np.random.default_rng(0)
@@ -141,6 +147,38 @@ def main() -> None:
     print(f"  {'CartPoleVectorEnv':<45} {per / t_cart:>12,.0f} steps/s")
     for label, t in zip(labels, times, strict=True):
         print(f"  {label:<45} {per / t:>12,.0f} steps/s  ratio {t_cart / t:.2f}")
+    solar(args, rng)
+
+
+def solar(args: argparse.Namespace, rng: np.random.Generator) -> None:
+    """``OrbitRaisingSolar-v0`` against CartPole, single and at `NUM_ENVS`, random actions."""
+    n, m = args.solar_steps, args.solar_vector_steps
+    cartpole = gym.make("CartPole-v1")
+    cart_actions = rng.integers(0, 2, n).tolist()
+    env = gym.make(SOLAR_ENV_ID)
+    actions = rng.integers(0, env.action_space.n, n).tolist()
+    t_cart, t_env = best_of(
+        args.repeats, lambda: time_single(cartpole, cart_actions), lambda: time_single(env, actions)
+    )
+    print(f"{SOLAR_ENV_ID}, random actions, single env, {n} steps, best of {args.repeats}")
+    print(f"  {'CartPole-v1':<45} {n / t_cart:>12,.0f} steps/s")
+    print(f"  {SOLAR_ENV_ID:<45} {n / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
+    cart_vec = CartPoleVectorEnv(num_envs=NUM_ENVS)
+    vec = gym.make_vec(SOLAR_ENV_ID, num_envs=NUM_ENVS)
+    cart_vec_actions = [rng.integers(0, 2, NUM_ENVS) for _ in range(m)]
+    vec_actions = [rng.integers(0, 4, NUM_ENVS) for _ in range(m)]
+    # The batch's missions start together and end together after 61 steps: the timed steps straddle that
+    # end (every mission's rule judged in one step), so the mean step is the steady state's or worse.
+    warmup = max(vec.unwrapped.task.config.horizon_steps - m // 2, 0)
+    t_cart, t_env = best_of(
+        args.repeats,
+        lambda: time_vector(cart_vec, cart_vec_actions, warmup),
+        lambda: time_vector(vec, vec_actions, warmup),
+    )
+    per = m * NUM_ENVS
+    print(f"{SOLAR_ENV_ID}, random actions, vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}")
+    print(f"  {'CartPoleVectorEnv':<45} {per / t_cart:>12,.0f} steps/s")
+    print(f"  {SOLAR_ENV_ID:<45} {per / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
 
 
 if __name__ == "__main__":

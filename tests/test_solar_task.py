@@ -200,7 +200,7 @@ def test_the_optimum_beats_every_rule_on_its_mission() -> None:
 @pytest.mark.slow
 def test_evaluate_scores_the_test_split_by_default() -> None:
     out = subprocess.run(
-        [sys.executable, "-m", "orbit_env", "evaluate", "--env", SOLAR_ENV_ID, "--episodes", "4", "--json"],
+        [sys.executable, "-m", "orbit_env.cli", "evaluate", "--env", SOLAR_ENV_ID, "--episodes", "4", "--json"],
         capture_output=True,
         text=True,
         check=True,

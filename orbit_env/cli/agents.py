@@ -87,7 +87,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
     from orbit_env.agents.evaluate import format_table, paired_difference, summarize
-    from orbit_env.agents.solar import evaluate_solar, solar_report
+    from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
 
     if args.model is not None:
         print(
@@ -105,7 +105,9 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
     table = summarize(results)
     report = solar_report(evaluation)
-    paired = [paired_difference(results, name="dp")] if "dp" in results else []
+    # The optimum against the best operators' rule, episode by episode.
+    best_rule = max(SOLAR_HAND_CODED, key=lambda name: results[name].returns.mean())
+    paired = [paired_difference(results, name="dp", baseline=best_rule)] if "dp" in results else []
     if args.json:
         out = {
             "env": args.env,
