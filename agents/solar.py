@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from typing import Any
 
@@ -237,8 +237,6 @@ def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
 
 
 def _with_split(mission: SolarMission, split: str) -> SolarMission:
-    from dataclasses import replace
-
     return replace(mission, solar_split=split)
 
 

@@ -62,10 +62,6 @@ class SolarGrid:
     burn_points: dict[float, tuple[FloatArray, FloatArray]]  # made -> (label, tau) after it, each (L, T)
 
 
-def _clamped_label(task: SolarTask, label: FloatArray) -> FloatArray:
-    return np.maximum(label, MU_LOW)
-
-
 @lru_cache(maxsize=4)
 def solar_grid(task: SolarTask) -> SolarGrid:
     """The grid of a task (cached: the burns' relocations are the same for every episode)."""
@@ -75,7 +71,7 @@ def solar_grid(task: SolarTask) -> SolarGrid:
     hp = np.linspace(REENTRY_ALTITUDE_M + 5e3, config.start_perigee_km[1] * 1e3 + 20e3, 40)
     span = np.geomspace(10.0, 1200e3, 60)
     hp_s, span_s = np.meshgrid(hp, span)
-    labels = _clamped_label(task, curves.locate(hp_s.ravel(), (hp_s + span_s).ravel()).label)
+    labels = np.maximum(curves.locate(hp_s.ravel(), (hp_s + span_s).ravel()).label, MU_LOW)
     label_axis = np.unique(np.quantile(labels, np.linspace(0.0, 1.0, LABEL_POINTS)))
     label_axis[0] = MU_LOW
     top = curves.locate(np.array([config.start_perigee_km[1] * 1e3]), np.array([1600e3])).tau
@@ -95,7 +91,7 @@ def solar_grid(task: SolarTask) -> SolarGrid:
         states = task_model.states_on_curves(task, mu.ravel(), tau.ravel(), capacity, 0.0)
         task_model.burn(task, states, float(made))
         points[float(made)] = (
-            _clamped_label(task, states.label.copy()).reshape(mu.shape),
+            np.maximum(states.label, MU_LOW).reshape(mu.shape),
             states.tau.copy().reshape(mu.shape),
         )
     return SolarGrid(
@@ -157,7 +153,7 @@ class SolarDP:
             day = self.start_day + k * block
             taus_c, lived_c = [], []
             for c in c_nodes:
-                lived, nu, _, _, _ = solar_task.coast_block(
+                after = solar_task.coast_block(
                     task.clock,
                     task.curves,
                     label_flat,
@@ -168,8 +164,8 @@ class SolarDP:
                     np.full(label_flat.size, day),
                     float(block),
                 )
-                taus_c.append(np.log1p(nu / NU_REF).reshape(n_l, n_t))
-                lived_c.append(lived.reshape(n_l, n_t))
+                taus_c.append(after.tau.reshape(n_l, n_t))
+                lived_c.append(after.lived_days.reshape(n_l, n_t))
             taus_c, lived_c = np.stack(taus_c), np.stack(lived_c)  # (C, L, T)
             # Each level's coast: between its two mass nodes.
             tau_k = (1.0 - c_weight)[None, None, :] * taus_c[c_index].transpose(1, 2, 0) + c_weight[

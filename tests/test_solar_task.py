@@ -55,8 +55,9 @@ def _drag_clock_life(hp_km: float, ha_km: float, date: str) -> float:
     gc = st.drag_rate(state)
     day, lived = float(task.clock.day_of(unix_days(date))), 0.0
     while nu[0] > 0.0:
-        days, nu, hp, ha, _ = st.coast_block(task.clock, task.curves, label, nu, hp, ha, gc, np.array([day]), 30.0)
-        lived += float(days[0])
+        after = st.coast_block(task.clock, task.curves, label, nu, hp, ha, gc, np.array([day]), 30.0)
+        nu, hp, ha = after.nu, after.perigee_m, after.apogee_m
+        lived += float(after.lived_days[0])
         day += 30.0
     return lived
 

@@ -206,6 +206,18 @@ class SolarTask(Task):
         return spaces.Box(SOLAR_OBS_LOW, SOLAR_OBS_HIGH, dtype=np.float32)
 
 
+class Coast(NamedTuple):
+    """Orbits after `coast_block` (arrays of the orbits' shape)."""
+
+    lived_days: FloatArray  # days lived in the span (its length, or the fraction before re-entry)
+    nu: FloatArray
+    tau: FloatArray
+    perigee_m: FloatArray
+    apogee_m: FloatArray
+    period_s: FloatArray  # the mean period left at the new point
+    ratio: FloatArray  # the span's mean multiplier at the perigee of its start
+
+
 class SolarStep(NamedTuple):
     """What `step` returns besides the updated state (arrays over the batch)."""
 
@@ -320,14 +332,11 @@ def coast_block(
     gc: FloatArray,
     first_day: FloatArray,
     days: float,
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+) -> Coast:
     """Decay orbits over ``days`` days from ``first_day`` (whole days) at the drag clock of their perigee.
 
     W = Int P dnu falls by g c x the drag-days of the span at the perigee of its start; an orbit
     whose W runs out re-enters at that fraction of the span (the span's mean rate).
-
-    Returns:
-        (days lived in the span, nu, perigee, apogee after it, the span's mean multiplier).
     """
     _, _, weighted = curves.weighted_at(label, nu)
     drag = clock.drag_days(perigee_m, first_day, first_day + math.ceil(days)) * (days / math.ceil(days))
@@ -337,14 +346,15 @@ def coast_block(
     new_nu = np.where(
         target > 0.0, curves.nu_at_weight(label, nu, weighted, np.maximum(target, 0.0), perigee_m, apogee_m), 0.0
     )
-    hp, ha, _ = curves.weighted_at(label, new_nu)
-    return lived, new_nu, hp, ha, drag / days
+    tau = np.log1p(new_nu / NU_REF)
+    hp, ha, period = curves.at(label, tau)
+    return Coast(lived, new_nu, tau, hp, ha, period, drag / days)
 
 
 def coast(task: SolarTask, state: BatchState) -> FloatArray:
     """One step's decay (`coast_block` over `SolarMission.block_days`), in place; return the days lived."""
     block = task.mission.block_days
-    lived, nu, hp, ha, ratio = coast_block(
+    after = coast_block(
         task.clock,
         task.curves,
         state.label,
@@ -355,17 +365,17 @@ def coast(task: SolarTask, state: BatchState) -> FloatArray:
         today(task, state),
         float(block),
     )
-    state.perigee_drop_m = state.perigee_m - hp
-    state.apogee_drop_m = state.apogee_m - ha
-    state.nu = nu
-    state.tau = np.log1p(nu / NU_REF)
-    state.perigee_m, state.apogee_m = hp, ha
-    state.period_s = np.where(nu > 0.0, task.curves.at(state.label, state.tau)[2], state.period_s)
+    state.perigee_drop_m = state.perigee_m - after.perigee_m
+    state.apogee_drop_m = state.apogee_m - after.apogee_m
+    state.nu = after.nu
+    state.tau = after.tau
+    state.perigee_m, state.apogee_m = after.perigee_m, after.apogee_m
+    state.period_s = np.where(after.nu > 0.0, after.period_s, state.period_s)
     state.segments[0] = STALE_SEGMENT
-    state.density_scale = ratio
-    state.time_days += lived
+    state.density_scale = after.ratio
+    state.time_days += after.lived_days
     state.steps += 1.0
-    return lived
+    return after.lived_days
 
 
 def life_margin_days(
@@ -394,10 +404,16 @@ def life_margin_days(
     rate = np.zeros(label.shape)
     while alive.size and t < horizon:
         span = min(block, horizon - t)
-        lived, nu[alive], hp[alive], ha[alive], ratio = coast_block(
+        after = coast_block(
             task.clock, task.curves, label[alive], nu[alive], hp[alive], ha[alive], gc[alive], day[alive] + t, span
         )
-        rate[alive] = ratio
+        lived, nu[alive], hp[alive], ha[alive], rate[alive] = (
+            after.lived_days,
+            after.nu,
+            after.perigee_m,
+            after.apogee_m,
+            after.ratio,
+        )
         ended = nu[alive] <= 0.0
         margin[alive[ended]] = t + lived[ended] - horizon
         alive = alive[~ended]
