@@ -155,7 +155,6 @@ class SolarDP:
             for c in c_nodes:
                 after = solar_task.coast_block(
                     task.clock,
-                    task.curves,
                     label_flat,
                     grid.nu.ravel(),
                     grid.perigee_m.ravel(),

@@ -93,7 +93,7 @@ def test_every_kernel_parameter_is_the_tasks(name: str) -> None:
 def test_every_grid_scale_is_the_grids() -> None:
     curves = universal_curves()
     for grid in (curves.table_a, curves.table_b):
-        scales = kernel_module._tables(curves)[1 if grid is curves.table_a else 3]
+        scales = kernel_module.tables(curves)[1 if grid is curves.table_a else 3]
         for field in GridScales._fields:
             assert scales[getattr(kernel_module._G, field)] == getattr(grid, field), field
     # grid_cell takes a GridScales after (x, y), in its order (``grid_cell(x, y, *scales)``).
@@ -107,10 +107,10 @@ def compiled_lookups():
     kernel_module.compiled()  # registers the helpers the lookups call
 
     def cell(grid, x, y):
-        return kernel_module._cell(grid, x, y)
+        return kernel_module.cell(grid, x, y)
 
     def table_a_point(perigee_m, apogee_m, cells, grid):
-        return kernel_module._table_a_point(perigee_m, apogee_m, cells, grid)
+        return kernel_module.table_a_point(perigee_m, apogee_m, cells, grid)
 
     def new_segment(data, cells, grid, label, tau):
         return kernel_module._new_segment(data, 0, cells, grid, label, tau)
@@ -129,7 +129,7 @@ def test_the_curve_lookups_agree_bit_for_bit(compiled_lookups) -> None:
     rng = np.random.default_rng(12)
     curves = universal_curves()
     a, b = curves.table_a, curves.table_b
-    a_cells, a_scales, b_cells, b_scales = kernel_module._tables(curves)
+    a_cells, a_scales, b_cells, b_scales = kernel_module.tables(curves)
     n = 3000
     # Table A over (perigee, ln e); table B over (label, tau): a margin beyond each edge.
     hp = rng.uniform(50e3, 1300e3, n)

@@ -23,10 +23,14 @@ from orbit_env.analysis.air.msis import MsisAir
 from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.decay.chunked import RATIO_GRID_M
+from orbit_env.decay.curves import NU_REF
+from orbit_env.decay.drag_clock import drag_days_at
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import shipped_record
 from orbit_env.envs import SOLAR_ENV_ID
+from orbit_env.envs import solar_kernel as sk
 from orbit_env.envs import solar_task as st
+from orbit_env.envs.kernel import JIT_VARIABLE
 from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
 
 TEST_TASK = st.SolarTask(mission=st.SolarMission(solar_split="test"))
@@ -47,6 +51,73 @@ def test_the_drag_clock_adds_up_and_is_the_days_multipliers() -> None:
     np.testing.assert_allclose(whole, ratios.sum(), rtol=1e-9)
 
 
+def test_the_drag_days_of_one_orbit_are_the_arrays() -> None:
+    # The compiled coast's scalar lookup against the array form: the same operations, so equal to
+    # the last bits of exp and log (1e-14).
+    clock = TEST_TASK.clock
+    rng = np.random.default_rng(4)
+    h = rng.uniform(80e3, 1300e3, 200)  # beyond the table's rows at both ends too
+    d0 = rng.integers(400, 30000, 200).astype(np.float64)
+    d1 = d0 + rng.integers(0, 60, 200)
+    scalar = [drag_days_at(clock.cumulative_days, *args) for args in zip(h, d0, d1, strict=True)]
+    np.testing.assert_allclose(scalar, clock.drag_days(h, d0, d1), rtol=1e-14, atol=0.0)
+
+
+def _random_orbits(size: int, seed: int) -> tuple[st.BatchState, np.ndarray, np.ndarray]:
+    state = st.start(TEST_TASK, np.random.default_rng(seed), size)
+    return state, st.drag_rate(state), st.today(TEST_TASK, state)
+
+
+def test_the_compiled_coast_is_the_curves_array_lookups() -> None:
+    # An independent path: UniversalCurves' array lookups (weighted_at, nu_at_weight: numpy) and the
+    # clock's array drag-days, against the compiled loop. Same formulas, other code: equal to 1e-12.
+    task = TEST_TASK
+    state, gc, day = _random_orbits(300, 5)
+    after = st.coast_block(task.clock, state.label, state.nu, state.perigee_m, state.apogee_m, gc, day, 30.0)
+    _, _, weighted = task.curves.weighted_at(state.label, state.nu)
+    drag = task.clock.drag_days(state.perigee_m, day, day + 30.0)
+    target = weighted - gc * drag * 86400.0
+    assert np.all(target > 0.0)  # 380-580 km: a month never ends them
+    nu = task.curves.nu_at_weight(state.label, state.nu, weighted, target, state.perigee_m, state.apogee_m)
+    np.testing.assert_allclose(after.nu, nu, rtol=1e-12)
+    np.testing.assert_allclose(after.ratio, drag / 30.0, rtol=1e-12)
+    hp, ha, period = task.curves.at(state.label, np.log1p(nu / NU_REF))
+    np.testing.assert_allclose(after.perigee_m, hp, rtol=1e-12)
+    np.testing.assert_allclose(after.apogee_m, ha, rtol=1e-12)
+    np.testing.assert_allclose(after.period_s, period, rtol=1e-12)
+    assert np.all(after.lived_days == 30.0)
+
+
+def test_the_compiled_loops_are_the_plain_functions(monkeypatch: pytest.MonkeyPatch) -> None:
+    # ORBIT_ENV_JIT=0 runs the same functions uncompiled: numba's machine code against CPython's floats,
+    # equal to the last bits of the C library's exp, log and log1p (1e-12 relative; the disposal's
+    # perigee 1e-6 m: a bisection whose branch a last-bit difference could flip would move it a
+    # candidate, 0.5 km, and fail).
+    task = TEST_TASK
+    state, gc, day = _random_orbits(12, 6)
+    state.steps = np.full(state.size, float(task.config.horizon_steps))
+    rows = (state.label, state.nu, state.perigee_m, state.apogee_m, gc, day)
+
+    def run() -> tuple[np.ndarray, ...]:
+        coast = sk.coast_rows(task.clock, *rows, 30.0)
+        margin = sk.life_margin_rows(task.clock, *rows, 30.0, task.mission.disposal_days)
+        lowered = sk.disposal_perigee_rows(task.clock, *rows, 30.0, task.mission.disposal_days, 24)
+        return coast, margin, lowered
+
+    compiled = run()
+    monkeypatch.setenv(JIT_VARIABLE, "0")
+    sk.loops.cache_clear()
+    try:
+        plain = run()
+    finally:
+        sk.loops.cache_clear()
+    assert sk.loops.cache_info().currsize == 0
+    np.testing.assert_allclose(compiled[0], plain[0], rtol=1e-12)
+    np.testing.assert_allclose(compiled[1], plain[1], rtol=1e-12)
+    np.testing.assert_allclose(compiled[2], plain[2], rtol=0.0, atol=1e-6)
+    assert np.any(compiled[2] < state.perigee_m)  # some need a disposal burn: the search ran
+
+
 def _drag_clock_life(hp_km: float, ha_km: float, date: str) -> float:
     """Days to re-entry of the 210 kg, 1 m^2 satellite by the task's monthly coasts."""
     task = TEST_TASK
@@ -55,7 +126,7 @@ def _drag_clock_life(hp_km: float, ha_km: float, date: str) -> float:
     gc = st.drag_rate(state)
     day, lived = float(task.clock.day_of(unix_days(date))), 0.0
     while nu[0] > 0.0:
-        after = st.coast_block(task.clock, task.curves, label, nu, hp, ha, gc, np.array([day]), 30.0)
+        after = st.coast_block(task.clock, label, nu, hp, ha, gc, np.array([day]), 30.0)
         nu, hp, ha = after.nu, after.perigee_m, after.apogee_m
         lived += float(after.lived_days[0])
         day += 30.0

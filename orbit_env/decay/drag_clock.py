@@ -21,6 +21,7 @@ Units: SI inside (m, s); spans in whole days since the record's first day.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 
@@ -128,10 +129,15 @@ def _trailing_mean(values: FloatArray, window: int) -> FloatArray:
     return (total[end] - total[begin]) / (end - begin)
 
 
+#: `RATIO_GRID_M` as the drag-days lookups read it: its first height, its spacing [m], the highest row coordinate.
+GRID_FIRST_M = float(RATIO_GRID_M[0])
+GRID_STEP_M = float(RATIO_GRID_M[1] - RATIO_GRID_M[0])
+GRID_TOP = RATIO_GRID_M.size - 1.000001
+
+
 def drag_days(cumulative: FloatArray, perigee_m: ArrayLike, first_day: ArrayLike, last_day: ArrayLike) -> FloatArray:
     """`DragClock.drag_days` on a clock's ``cumulative_days`` table (rows on `RATIO_GRID_M`)."""
-    grid = RATIO_GRID_M
-    x = np.clip((np.asarray(perigee_m, dtype=np.float64) - grid[0]) / (grid[1] - grid[0]), 0.0, grid.size - 1.000001)
+    x = np.clip((np.asarray(perigee_m, dtype=np.float64) - GRID_FIRST_M) / GRID_STEP_M, 0.0, GRID_TOP)
     row = x.astype(np.intp)
     w = x - row
     d0 = np.asarray(first_day, dtype=np.intp)
@@ -148,3 +154,20 @@ def drag_days(cumulative: FloatArray, perigee_m: ArrayLike, first_day: ArrayLike
 def drag_clock(inclination_deg: float = 53.0, version: float = DEFAULT_MSIS_VERSION) -> DragClock:
     """The process's drag clock of an orbit plane (one per inclination and version)."""
     return DragClock(float(inclination_deg), float(version))
+
+
+def drag_days_at(cumulative: FloatArray, perigee_m: float, first_day: float, last_day: float) -> float:
+    """`drag_days` of one orbit in plain floats (the same operations), for the compiled solar task.
+
+    ``orbit_env.envs.solar_kernel`` compiles it with numba; ``tests/test_solar_task.py`` holds it
+    equal to the array form.
+    """
+    x = min(max((perigee_m - GRID_FIRST_M) / GRID_STEP_M, 0.0), GRID_TOP)
+    row = int(x)
+    w = x - row
+    d0, d1 = int(first_day), int(last_day)
+    low = cumulative[row, d1] - cumulative[row, d0]
+    if not low > 0.0:
+        return 0.0
+    high = cumulative[row + 1, d1] - cumulative[row + 1, d0]
+    return low * math.exp(w * (math.log(high) - math.log(low)))

@@ -10,7 +10,8 @@ between them (the C library's, one number at a time in a loop, cost twice as muc
 The formulas are `orbit_env.envs.task`'s, in the same order, on the same state array and
 the same tables of the universal curves (`orbit_env.decay.curves`). The solar task
 (`orbit_env.envs.solar_task`) burns through `burn_rows` too, on its own curves; its month of
-decay by the drag clock is numpy's.
+decay by the drag clock, its rule and its disposal burn are compiled in
+`orbit_env.envs.solar_kernel`, which reads the tables through `tables` and `cell`.
 
 The contract with the task model is declared once: the state's rows are
 `orbit_env.envs.state.ROW`, the task's numbers `KernelParameters`, a table's scales
@@ -77,7 +78,7 @@ _P = KernelParameters(*range(len(KernelParameters._fields)))
 _G = GridScales(*range(len(GridScales._fields)))
 
 
-def _cell(grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]:
+def cell(grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]:
     """`grid_cell` of one point on a grid given by its `GridScales` as an array: row, tx, j, ty."""
     return grid_cell(
         x,
@@ -92,12 +93,12 @@ def _cell(grid: FloatArray, x: float, y: float) -> tuple[int, float, int, float]
     )
 
 
-def _table_a_point(perigee_m: float, apogee_m: float, a_cells: FloatArray, a_grid: FloatArray) -> tuple[float, float]:
+def table_a_point(perigee_m: float, apogee_m: float, a_cells: FloatArray, a_grid: FloatArray) -> tuple[float, float]:
     """`UniversalCurves.locate` of one orbit: table A's (label, tau), bilinear (`BilinearGrid.values_scalar`)."""
     rp = EARTH_RADIUS_M + perigee_m
     ra = EARTH_RADIUS_M + apogee_m
     y = math.log(max((ra - rp) / (ra + rp), E_FLOOR))
-    row, tx, _, ty = _cell(a_grid, perigee_m, y)
+    row, tx, _, ty = cell(a_grid, perigee_m, y)
     txy = tx * ty
     a0 = a_cells[row, 0, 1] * tx + a_cells[row, 0, 0] + a_cells[row, 0, 2] * ty + a_cells[row, 0, 3] * txy
     a1 = a_cells[row, 1, 1] * tx + a_cells[row, 1, 0] + a_cells[row, 1, 2] * ty + a_cells[row, 1, 3] * txy
@@ -115,8 +116,8 @@ def _relocate(
 ) -> None:
     """`task.place_burnt` of row ``k``: moved by table A's difference, then label, tau, nu, period, heights, cell."""
     perigee = data[ROW.perigee_m, k]
-    before_label, before_tau = _table_a_point(perigee, data[ROW.apogee_m, k], a_cells, a_grid)
-    after_label, after_tau = _table_a_point(perigee, apogee_after_m, a_cells, a_grid)
+    before_label, before_tau = table_a_point(perigee, data[ROW.apogee_m, k], a_cells, a_grid)
+    after_label, after_tau = table_a_point(perigee, apogee_after_m, a_cells, a_grid)
     label = data[ROW.label, k] + (after_label - before_label)
     tau = max(data[ROW.tau, k] + (after_tau - before_tau), 0.0)
     data[ROW.label, k] = label
@@ -128,7 +129,7 @@ def _relocate(
 
 def _new_segment(data: FloatArray, k: int, b_cells: FloatArray, b_grid: FloatArray, label: float, tau: float) -> float:
     """`BilinearGrid.segment_scalar` of row ``k`` into its cell rows; returns ty."""
-    row, tx, j, ty = _cell(b_grid, label, tau)
+    row, tx, j, ty = cell(b_grid, label, tau)
     data[SEGMENT_ROW, k] = j
     for m in range(3):
         data[SEGMENT_ROW + 1 + m, k] = b_cells[row, m, 1] * tx + b_cells[row, m, 0]
@@ -373,7 +374,7 @@ def compiled() -> _Kernels | None:
         import numba
     except ImportError:
         return None
-    helpers = (grid_cell, _cell, _table_a_point, _relocate, _new_segment, _heights_on_segment)
+    helpers = (grid_cell, cell, table_a_point, _relocate, _new_segment, _heights_on_segment)
     helpers += (_perigee_speed_m_s, _apogee_after_m, _sine)
     for helper in (*helpers, _set_density_scale, _update_density, _burn):
         # Callable from the compiled loops, unchanged from Python. Not inlined by numba (that took the
@@ -384,7 +385,7 @@ def compiled() -> _Kernels | None:
 
 
 @lru_cache(maxsize=8)
-def _tables(curves: UniversalCurves) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+def tables(curves: UniversalCurves) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Tables A and B of the curves as the loops read them: cells (rows, k, 4) and `GridScales` as an array."""
     a, b = curves.table_a, curves.table_b
     return a.cells, np.array(a.scales, dtype=np.float64), b.cells, np.array(b.scales, dtype=np.float64)
@@ -421,7 +422,7 @@ def burn_rows(
     if requested.shape != (n,):
         requested = np.full(n, float(requested))
     made = np.zeros(n)
-    kernels.burn_rows(state_data, rows, requested, parameters, *_tables(curves), made)
+    kernels.burn_rows(state_data, rows, requested, parameters, *tables(curves), made)
     return made
 
 
@@ -445,7 +446,7 @@ def coast_and_observe(
     kernels = compiled()
     assert kernels is not None, "coast_and_observe needs the compiled loops"
     n = state_data.shape[1]
-    _, _, b_cells, b_grid = _tables(curves)
+    _, _, b_cells, b_grid = tables(curves)
     first, second = np.empty(n), np.empty(n)
     if parameters[_P.density_varies] != 0.0:
         kernels.modulation_exponents(state_data[ROW.time_days], state_data[ROW.density_phase_rad], parameters, first)

@@ -35,10 +35,11 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from orbit_env.checks import check_number
-from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import SECONDS_PER_DAY
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution
 from orbit_env.decay.drag_clock import DragClock, drag_clock
 from orbit_env.decay.solar import iso_date, unix_days
+from orbit_env.envs import solar_kernel
 from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.state import STALE_SEGMENT, BatchState
 from orbit_env.envs.task import (
@@ -64,9 +65,9 @@ SPLIT_DATE = "2009-01-01"
 SOLAR_SPLITS = ("train", "test")
 #: Days of the record a mission's first day needs before it: the observation's trailing 365-day mean.
 HISTORY_DAYS = 365
-#: Candidate perigees of the disposal burn per pass (from 100 km to the perigee; two passes, the second
-#: between the last compliant candidate and the next: the cheapest compliant burn to within
-#: (h_p - 100 km) / CANDIDATES^2, under 0.5 km of perigee, about 0.15 m/s).
+#: Candidate perigees of the disposal burn per pass (from 100 km to the perigee, searched by bisection; two
+#: passes, the second between the last compliant candidate and the next: the cheapest compliant burn to
+#: within (h_p - 100 km) / CANDIDATES^2, under 0.5 km of perigee, about 0.15 m/s).
 DISPOSAL_CANDIDATES = 24
 
 #: The satellite and the mission of ``OrbitRaisingSolar-v0`` (why each, measured: docs/solar-task.md).
@@ -324,7 +325,6 @@ def drag_rate(state: BatchState) -> FloatArray:
 
 def coast_block(
     clock: DragClock,
-    curves: UniversalCurves,
     label: FloatArray,
     nu: FloatArray,
     perigee_m: FloatArray,
@@ -336,19 +336,12 @@ def coast_block(
     """Decay orbits over ``days`` days from ``first_day`` (whole days) at the drag clock of their perigee.
 
     W = Int P dnu falls by g c x the drag-days of the span at the perigee of its start; an orbit
-    whose W runs out re-enters at that fraction of the span (the span's mean rate).
+    whose W runs out re-enters at that fraction of the span (the span's mean rate). Compiled
+    (`orbit_env.envs.solar_kernel`); arrays of the orbits' shape out.
     """
-    _, _, weighted = curves.weighted_at(label, nu)
-    drag = clock.drag_days(perigee_m, first_day, first_day + math.ceil(days)) * (days / math.ceil(days))
-    drop = gc * drag * SECONDS_PER_DAY
-    target = weighted - drop
-    lived = np.where(target > 0.0, days, days * weighted / np.maximum(drop, 1e-300))
-    new_nu = np.where(
-        target > 0.0, curves.nu_at_weight(label, nu, weighted, np.maximum(target, 0.0), perigee_m, apogee_m), 0.0
-    )
-    tau = np.log1p(new_nu / NU_REF)
-    hp, ha, period = curves.at(label, tau)
-    return Coast(lived, new_nu, tau, hp, ha, period, drag / days)
+    shape = np.broadcast_shapes(*(np.shape(a) for a in (label, nu, perigee_m, apogee_m, gc, first_day)))
+    rows = solar_kernel.coast_rows(clock, label, nu, perigee_m, apogee_m, gc, first_day, days)
+    return Coast(*(row.reshape(shape) for row in rows))
 
 
 def coast(task: SolarTask, state: BatchState) -> FloatArray:
@@ -356,7 +349,6 @@ def coast(task: SolarTask, state: BatchState) -> FloatArray:
     block = task.mission.block_days
     after = coast_block(
         task.clock,
-        task.curves,
         state.label,
         state.nu,
         state.perigee_m,
@@ -387,41 +379,15 @@ def life_margin_days(
     gc: FloatArray,
     first_day: FloatArray,
 ) -> FloatArray:
-    """Re-entry day after ``first_day`` minus the rule's days: <= 0 complies.
+    """Re-entry day after ``first_day`` minus the rule's days: <= 0 complies (1-d over the broadcast orbits).
 
     The orbits decay by `coast_block` in the task's steps up to the rule's end; one still up
     then gets its W left over its last rate (days it would still live at that rate), > 0.
     """
-    block = float(task.mission.block_days)
-    horizon = task.mission.disposal_days
-    label, nu, hp, ha, gc, day = (
-        np.array(a, dtype=np.float64) for a in np.broadcast_arrays(label, nu, perigee_m, apogee_m, gc, first_day)
+    mission = task.mission
+    return solar_kernel.life_margin_rows(
+        task.clock, label, nu, perigee_m, apogee_m, gc, first_day, float(mission.block_days), mission.disposal_days
     )
-    margin = np.full(label.shape, np.nan)
-    t = 0.0
-    alive = np.flatnonzero(nu > 0.0)
-    margin[nu <= 0.0] = -horizon
-    rate = np.zeros(label.shape)
-    while alive.size and t < horizon:
-        span = min(block, horizon - t)
-        after = coast_block(
-            task.clock, task.curves, label[alive], nu[alive], hp[alive], ha[alive], gc[alive], day[alive] + t, span
-        )
-        lived, nu[alive], hp[alive], ha[alive], rate[alive] = (
-            after.lived_days,
-            after.nu,
-            after.perigee_m,
-            after.apogee_m,
-            after.ratio,
-        )
-        ended = nu[alive] <= 0.0
-        margin[alive[ended]] = t + lived[ended] - horizon
-        alive = alive[~ended]
-        t += span
-    if alive.size:
-        _, _, weighted = task.curves.weighted_at(label[alive], nu[alive])
-        margin[alive] = weighted / (gc[alive] * np.maximum(rate[alive], 1e-9) * SECONDS_PER_DAY)
-    return margin
 
 
 def disposal(task: SolarTask, state: BatchState) -> tuple[FloatArray, NDArray[np.bool_]]:
@@ -432,48 +398,26 @@ def disposal(task: SolarTask, state: BatchState) -> tuple[FloatArray, NDArray[np
     the judgement is on the safe side). The burn is retrograde at apogee and lowers the perigee
     (`orbit_env.physics.orbit.dv_to_lower_perigee_m_s`); the lowest candidate, 100 km, re-enters
     at once, so a compliant perigee always exists. Two passes of `DISPOSAL_CANDIDATES` candidate
-    perigees, the second between the last compliant and the next.
+    perigees, each searched by bisection, the second between the last compliant and the next
+    (`orbit_env.envs.solar_kernel`).
 
     Returns:
         (the burn [m/s], 0 where the orbit complies as it is; whether the propellant left makes it).
     """
-    n = state.size
-    label, nu, hp, ha, gc, day = (
+    mission = task.mission
+    lowered = solar_kernel.disposal_perigee_rows(
+        task.clock,
         state.label,
         state.nu,
         state.perigee_m,
         state.apogee_m,
         drag_rate(state),
         today(task, state),
+        float(mission.block_days),
+        mission.disposal_days,
+        DISPOSAL_CANDIDATES,
     )
-    margin = life_margin_days(task, label, nu, hp, ha, gc, day)
-    need = np.flatnonzero(margin > 0.0)
-    dv = np.zeros(n)
-    if need.size:
-        k = DISPOSAL_CANDIDATES
-        low = np.full(need.size, REENTRY_ALTITUDE_M)
-        high = hp[need].copy()
-        for _ in range(2):
-            fractions = np.arange(k + 1) / k  # candidate 0 is `low` (compliant), candidate k is `high`
-            candidates = low[:, None] + (high - low)[:, None] * fractions[None, :]
-            ha_c = np.broadcast_to(ha[need, None], candidates.shape)
-            point = task.curves.locate(candidates.ravel(), ha_c.ravel())
-            hp_c, ha_c2, _ = task.curves.at(point.label, point.tau)
-            m = life_margin_days(
-                task,
-                point.label,
-                point.nu,
-                hp_c,
-                ha_c2,
-                np.repeat(gc[need], k + 1),
-                np.repeat(day[need], k + 1),
-            ).reshape(candidates.shape)
-            m[:, 0] = np.minimum(m[:, 0], 0.0)
-            # The last compliant candidate in each row (compliance is monotone in the perigee).
-            last_ok = (k - np.argmax((m <= 0.0)[:, ::-1], axis=1)).clip(0, k - 1)
-            rows = np.arange(need.size)
-            low, high = candidates[rows, last_ok], candidates[rows, last_ok + 1]
-        dv[need] = dv_to_lower_perigee_m_s(hp[need], ha[need], low)
+    dv = dv_to_lower_perigee_m_s(state.perigee_m, state.apogee_m, lowered)
     able = dv <= state.dv_left_m_s + 1e-9
     return dv, able
 

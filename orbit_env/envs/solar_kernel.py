@@ -1,0 +1,414 @@
+"""The solar task's month of decay, its rule and its disposal burn, compiled: loops over the orbits (numba).
+
+The one implementation of `orbit_env.envs.solar_task`'s coast (`coast_block`), of the
+rule's judgement (`life_margin_days`) and of the cheapest compliant disposal burn
+(`disposal`): plain-float functions of one orbit, compiled by numba into loops over arrays
+(with ``ORBIT_ENV_JIT=0`` the same functions run uncompiled, slowly). An orbit's month is
+a handful of table lookups; the rule at a mission's end decays it (and each candidate
+disposal) month by month over five years, which numpy spent in thousands of small calls.
+
+They read the tables the rest of the package reads: table A (where heights fall on the
+curves) and table B (heights and period along a curve) of the drag clock's universal
+curves as `orbit_env.envs.kernel` reads them (`orbit_env.envs.kernel.tables`, its
+`orbit_env.envs.kernel.cell`), and the clock's cumulative drag-days
+(`orbit_env.decay.drag_clock.drag_days_at`). ``tests/test_solar_task.py`` holds the
+compiled loops equal to the uncompiled functions and the coast equal to the array
+lookups of `orbit_env.decay.curves.UniversalCurves` (``weighted_at``, ``nu_at_weight``).
+
+Units: SI (m, s); days for spans and the calendar (whole days since the record's first).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from functools import lru_cache
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
+from orbit_env.decay.curves import NU_REF, grid_cell
+from orbit_env.decay.drag_clock import DragClock, drag_days_at
+from orbit_env.envs.kernel import JIT_VARIABLE, cell, table_a_point, tables
+
+FloatArray = NDArray[np.float64]
+
+#: The lowest rate W may fall at when the rule's years end with the orbit still up (per day, relative).
+MIN_RATE = 1e-9
+
+
+class SolarTables(NamedTuple):
+    """What the loops read: tables A and B of the clock's curves (cells and scales) and its drag-days."""
+
+    a_cells: FloatArray
+    a_grid: FloatArray
+    b_cells: FloatArray
+    b_grid: FloatArray
+    cumulative: FloatArray
+
+
+@lru_cache(maxsize=4)
+def solar_tables(clock: DragClock) -> SolarTables:
+    """The tables of a drag clock (built once per clock)."""
+    return SolarTables(*tables(clock.curves), clock.cumulative_days)
+
+
+def _curve_at(label: float, tau: float, b_cells: FloatArray, b_grid: FloatArray) -> tuple[float, float, float]:
+    """`UniversalCurves.at` of one point: perigee [m], apogee [m], mean period left [s] (the same operations)."""
+    row, tx, _, ty = cell(b_grid, label, tau)
+    txy = tx * ty
+    b0 = b_cells[row, 0, 1] * tx + b_cells[row, 0, 0] + b_cells[row, 0, 2] * ty + b_cells[row, 0, 3] * txy
+    b1 = b_cells[row, 1, 1] * tx + b_cells[row, 1, 0] + b_cells[row, 1, 2] * ty + b_cells[row, 1, 3] * txy
+    q = b_cells[row, 2, 1] * tx + b_cells[row, 2, 0] + b_cells[row, 2, 2] * ty + b_cells[row, 2, 3] * txy
+    hp = max(b0, REENTRY_ALTITUDE_M)
+    one_minus_e = 1.0 - math.exp(b1 + label)
+    rp = hp + EARTH_RADIUS_M
+    return hp, (rp + rp) / one_minus_e - rp - EARTH_RADIUS_M, q
+
+
+def _kepler_period_s(perigee_m: float, apogee_m: float) -> float:
+    """`orbit.period_s` of `orbit.elements_from_heights`: the osculating ellipse's period [s]."""
+    rp = EARTH_RADIUS_M + perigee_m
+    ra = EARTH_RADIUS_M + apogee_m
+    e = (ra - rp) / (ra + rp)
+    a = rp * (1.0 + e) / (1.0 - e * e)
+    return TWO_PI * math.sqrt(a * a * a / MU_EARTH_M3_S2)
+
+
+def _nu_at_weight(
+    label: float,
+    nu: float,
+    weighted: float,
+    target: float,
+    perigee_m: float,
+    apogee_m: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+) -> float:
+    """`UniversalCurves.nu_at_weight` of one orbit: Newton's method on W(nu) = target, dW/dnu = P."""
+    nu = max(nu - (weighted - target) / _kepler_period_s(perigee_m, apogee_m), 0.0)
+    for _ in range(3):
+        hp, ha, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
+        nu = max(nu - (q * nu - target) / _kepler_period_s(hp, ha), 0.0)
+    return nu
+
+
+def _coast(
+    label: float,
+    nu: float,
+    perigee_m: float,
+    apogee_m: float,
+    gc: float,
+    first_day: float,
+    days: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> tuple[float, float, float, float, float, float, float]:
+    """One orbit's `coast_block`: (days lived, nu, tau, perigee, apogee, period, the span's mean multiplier).
+
+    W = Int P dnu falls by g c x the drag-days of the span at the perigee of its start; an orbit
+    whose W runs out re-enters at that fraction of the span (the span's mean rate).
+    """
+    _, _, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
+    weighted = q * nu
+    whole = math.ceil(days)
+    drag = drag_days_at(cumulative, perigee_m, first_day, first_day + whole) * (days / whole)
+    drop = gc * drag * SECONDS_PER_DAY
+    target = weighted - drop
+    if target > 0.0:
+        lived = days
+        nu = _nu_at_weight(label, nu, weighted, target, perigee_m, apogee_m, b_cells, b_grid)
+    else:
+        lived = days * weighted / max(drop, 1e-300)
+        nu = 0.0
+    tau = math.log1p(nu / NU_REF)
+    hp, ha, period = _curve_at(label, tau, b_cells, b_grid)
+    return lived, nu, tau, hp, ha, period, drag / days
+
+
+def _life_margin(
+    label: float,
+    nu: float,
+    perigee_m: float,
+    apogee_m: float,
+    gc: float,
+    first_day: float,
+    block_days: float,
+    horizon_days: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> float:
+    """Re-entry day after ``first_day`` minus ``horizon_days`` (<= 0 complies), by coasts of ``block_days``.
+
+    An orbit still up at the horizon gets its W left over its last span's rate (the days it
+    would still live at that rate, > 0).
+    """
+    if nu <= 0.0:
+        return -horizon_days
+    t = 0.0
+    rate = 0.0
+    while t < horizon_days:
+        span = min(block_days, horizon_days - t)
+        lived, nu, _, perigee_m, apogee_m, _, rate = _coast(
+            label, nu, perigee_m, apogee_m, gc, first_day + t, span, b_cells, b_grid, cumulative
+        )
+        if nu <= 0.0:
+            return t + lived - horizon_days
+        t += span
+    _, _, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
+    return q * nu / (gc * max(rate, MIN_RATE) * SECONDS_PER_DAY)
+
+
+def _candidate_margin(
+    perigee_m: float,
+    apogee_m: float,
+    gc: float,
+    first_day: float,
+    block_days: float,
+    horizon_days: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> float:
+    """`_life_margin` of the orbit a disposal burn leaves: located on the curves (table A), read back (table B)."""
+    label, tau = table_a_point(perigee_m, apogee_m, a_cells, a_grid)
+    hp, ha, _ = _curve_at(label, tau, b_cells, b_grid)
+    nu = NU_REF * math.expm1(tau)
+    return _life_margin(label, nu, hp, ha, gc, first_day, block_days, horizon_days, b_cells, b_grid, cumulative)
+
+
+def _disposal_perigee(
+    label: float,
+    nu: float,
+    perigee_m: float,
+    apogee_m: float,
+    gc: float,
+    first_day: float,
+    block_days: float,
+    horizon_days: float,
+    candidates: int,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> float:
+    """The highest perigee [m] a disposal burn may leave one orbit for it to comply (its own if it complies).
+
+    Two passes over ``candidates`` + 1 perigees evenly from 100 km (re-enters at once:
+    compliant) to the orbit's own (not compliant); each finds the highest compliant one by
+    bisection (compliance is monotone in the perigee) and the next pass searches between it
+    and the next. The cheapest compliant burn lowers the perigee to the last one found.
+    """
+    margin = _life_margin(
+        label, nu, perigee_m, apogee_m, gc, first_day, block_days, horizon_days, b_cells, b_grid, cumulative
+    )
+    if not margin > 0.0:
+        return perigee_m
+    low, high = REENTRY_ALTITUDE_M, perigee_m
+    for _ in range(2):
+        ok, bad = 0, candidates  # candidate indices: ok complies, bad does not
+        step = (high - low) / candidates
+        while bad - ok > 1:
+            middle = (ok + bad) // 2
+            m = _candidate_margin(
+                low + step * middle,
+                apogee_m,
+                gc,
+                first_day,
+                block_days,
+                horizon_days,
+                a_cells,
+                a_grid,
+                b_cells,
+                b_grid,
+                cumulative,
+            )
+            if m <= 0.0:
+                ok = middle
+            else:
+                bad = middle
+        low, high = low + step * ok, low + step * (ok + 1)
+    return low
+
+
+def _coast_rows(
+    label: FloatArray,
+    nu: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    gc: FloatArray,
+    first_day: FloatArray,
+    days: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    out: FloatArray,
+) -> None:
+    """`_coast` of every orbit into ``out`` (7, n), rows as `Coast`'s fields."""
+    for k in range(label.size):
+        result = _coast(
+            label[k], nu[k], perigee_m[k], apogee_m[k], gc[k], first_day[k], days, b_cells, b_grid, cumulative
+        )
+        for m in range(7):
+            out[m, k] = result[m]
+
+
+def _life_margin_rows(
+    label: FloatArray,
+    nu: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    gc: FloatArray,
+    first_day: FloatArray,
+    block_days: float,
+    horizon_days: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    out: FloatArray,
+) -> None:
+    """`_life_margin` of every orbit into ``out``."""
+    for k in range(label.size):
+        out[k] = _life_margin(
+            label[k],
+            nu[k],
+            perigee_m[k],
+            apogee_m[k],
+            gc[k],
+            first_day[k],
+            block_days,
+            horizon_days,
+            b_cells,
+            b_grid,
+            cumulative,
+        )
+
+
+def _disposal_rows(
+    label: FloatArray,
+    nu: FloatArray,
+    perigee_m: FloatArray,
+    apogee_m: FloatArray,
+    gc: FloatArray,
+    first_day: FloatArray,
+    block_days: float,
+    horizon_days: float,
+    candidates: int,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    out: FloatArray,
+) -> None:
+    """`_disposal_perigee` of every orbit into ``out``."""
+    for k in range(label.size):
+        out[k] = _disposal_perigee(
+            label[k],
+            nu[k],
+            perigee_m[k],
+            apogee_m[k],
+            gc[k],
+            first_day[k],
+            block_days,
+            horizon_days,
+            candidates,
+            a_cells,
+            a_grid,
+            b_cells,
+            b_grid,
+            cumulative,
+        )
+
+
+class _Loops(NamedTuple):
+    """The loops over orbits (compiled, or the plain functions with ``ORBIT_ENV_JIT=0``)."""
+
+    coast_rows: Any
+    life_margin_rows: Any
+    disposal_rows: Any
+
+
+_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows)
+
+
+@lru_cache(maxsize=1)
+def loops() -> _Loops:
+    """The loops, compiled by numba on first use (cached on disk); uncompiled with ``ORBIT_ENV_JIT=0``."""
+    if os.environ.get(JIT_VARIABLE, "1").strip() == "0":
+        return _PLAIN
+    import numba
+
+    helpers = (grid_cell, cell, table_a_point, drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast)
+    for helper in (*helpers, _life_margin, _candidate_margin, _disposal_perigee):
+        numba.extending.register_jitable(helper)
+    return _Loops(*(numba.njit(cache=True, nogil=True)(loop) for loop in _PLAIN))
+
+
+def _float_rows(*arrays: Any) -> list[FloatArray]:
+    """The arguments broadcast together, as contiguous 1-d float64 arrays."""
+    return [np.ascontiguousarray(a, dtype=np.float64).ravel() for a in np.broadcast_arrays(*arrays)]
+
+
+def coast_rows(
+    clock: DragClock,
+    label: Any,
+    nu: Any,
+    perigee_m: Any,
+    apogee_m: Any,
+    gc: Any,
+    first_day: Any,
+    days: float,
+) -> FloatArray:
+    """Orbits (arrays that broadcast) coasted ``days`` from ``first_day``: a (7, n) array, rows as `Coast`."""
+    t = solar_tables(clock)
+    rows = _float_rows(label, nu, perigee_m, apogee_m, gc, first_day)
+    out = np.empty((7, rows[0].size))
+    loops().coast_rows(*rows, float(days), t.b_cells, t.b_grid, t.cumulative, out)
+    return out
+
+
+def life_margin_rows(
+    clock: DragClock,
+    label: Any,
+    nu: Any,
+    perigee_m: Any,
+    apogee_m: Any,
+    gc: Any,
+    first_day: Any,
+    block_days: float,
+    horizon_days: float,
+) -> FloatArray:
+    """`_life_margin` of orbits (arrays that broadcast), 1-d [days]."""
+    t = solar_tables(clock)
+    rows = _float_rows(label, nu, perigee_m, apogee_m, gc, first_day)
+    out = np.empty(rows[0].size)
+    loops().life_margin_rows(*rows, float(block_days), float(horizon_days), t.b_cells, t.b_grid, t.cumulative, out)
+    return out
+
+
+def disposal_perigee_rows(
+    clock: DragClock,
+    label: Any,
+    nu: Any,
+    perigee_m: Any,
+    apogee_m: Any,
+    gc: Any,
+    first_day: Any,
+    block_days: float,
+    horizon_days: float,
+    candidates: int,
+) -> FloatArray:
+    """`_disposal_perigee` of orbits (arrays that broadcast), 1-d [m]."""
+    t = solar_tables(clock)
+    rows = _float_rows(label, nu, perigee_m, apogee_m, gc, first_day)
+    out = np.empty(rows[0].size)
+    loops().disposal_rows(*rows, float(block_days), float(horizon_days), int(candidates), *t, out)
+    return out
