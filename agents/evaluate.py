@@ -243,6 +243,7 @@ SHIPPED_MODELS = {
     "OrbitRaising-v0": "ppo_orbit_raising.zip",
     "OrbitRaisingUncertain-v0": "ppo_orbit_raising_uncertain.zip",
     "OrbitRaisingContinuous-v0": "ppo_orbit_raising_continuous.zip",
+    "OrbitRaisingSolar-v0": "ppo_orbit_raising_solar.zip",
 }
 
 
@@ -328,7 +329,10 @@ def load_model(
     """
     from importlib import resources
 
-    check_env_id(env_id)
+    from orbit_env.envs import SOLAR_ENV_ID
+
+    if env_id != SOLAR_ENV_ID:
+        check_env_id(env_id)
     if model_path is None:
         if env_id not in SHIPPED_MODELS:
             return None
@@ -350,7 +354,7 @@ def load_model(
         raise ValueError(
             f"{path} does not load as a {algorithm.upper()} model: {type(error).__name__}: {error}"
         ) from None
-    base = task_of(env_id)
+    base = gymnasium.make(env_id).unwrapped  # its spaces (the solar task has no task_of)
     for what, mine, theirs in (
         ("action", base.action_space, model.action_space),
         ("observation", base.observation_space, model.observation_space),

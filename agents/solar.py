@@ -8,7 +8,8 @@ are tuned on the train split (`tune`), never on the test split. The optimum is t
 DP (`orbit_env.agents.solar_dp`), which knows the Sun's future.
 
 `evaluate_solar` scores them all on the same missions (drawn once from a seed; the DP's
-episodes solved and flown in worker processes), as ``orbit-env evaluate --env
+episodes solved and flown in worker processes), with any learned agent (`by_model`: the shipped
+PPO of ``agents/ppo_solar.toml``, trained on the train split), as ``orbit-env evaluate --env
 OrbitRaisingSolar-v0`` prints them.
 """
 
@@ -213,6 +214,29 @@ def by_observation(task: SolarTask, policy: Never) -> Callable[[BatchState], Flo
     return lambda state: sizes[policy.actions(solar_task.observe(task, state))]
 
 
+def by_model(task: SolarTask, model: Any) -> Callable[[BatchState], FloatArray]:
+    """A learned model (SB3's ``predict``) as `fly`'s ``act``: deterministic actions on the observation."""
+    sizes = np.array(task.config.burn_sizes_m_s)
+
+    def act(state: BatchState) -> FloatArray:
+        actions, _ = model.predict(solar_task.observe(task, state), deterministic=True)
+        return sizes[np.asarray(actions, dtype=np.int64).reshape(-1)]
+
+    return act
+
+
+def fly_model(model: Any, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> Flown:
+    """A learned model's missions: ``episodes`` starts drawn with ``seed`` from the split of ``env_kwargs``.
+
+    ``env_kwargs`` are the environment's keywords (the training config's ``[env]`` table; default: the
+    train split), so `orbit_env.agents.train.BestModelCallback` validates on the split trained on.
+    """
+    from orbit_env.envs.solar import solar_task_of
+
+    task = solar_task_of(None, dict(env_kwargs or {}))
+    return fly(task, starts(task, episodes, seed), by_model(task, model))
+
+
 @lru_cache(maxsize=4)
 def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
     """The thresholds (and reserves) of the two threshold rules that do best on the train split.
@@ -294,8 +318,13 @@ def evaluate_solar(
     include_dp: bool = True,
     workers: int | None = None,
     progress: Callable[[str], None] | None = None,
+    learned: Mapping[str, Any] | None = None,
 ) -> SolarEvaluation:
-    """Fly every hand-coded rule and the optimum on ``episodes`` missions of the split (drawn with ``seed``)."""
+    """Fly every hand-coded rule, the optimum and the ``learned`` agents on ``episodes`` missions of the split.
+
+    The missions are drawn with ``seed``. ``learned``: row name -> a model answering SB3's ``predict``
+    (e.g. ``{"ppo": model}``), flown with deterministic actions after the optimum's row.
+    """
     task = SolarTask(mission=SolarMission(solar_split=solar_split, disposal_years=disposal_years))
     options = starts(task, episodes, seed)
     say = progress or (lambda _: None)
@@ -325,6 +354,9 @@ def evaluate_solar(
             np.array(columns[5]),
         )
         estimate = np.array(columns[6])
+    for name, model in (learned or {}).items():
+        say(name)
+        flown[name] = fly(task, options, by_model(task, model))
     return SolarEvaluation(flown, estimate, dict(tune(task)))
 
 

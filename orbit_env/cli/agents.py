@@ -86,13 +86,12 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
 def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
-    from orbit_env.agents.evaluate import format_table, paired_difference, summarize
+    from orbit_env.agents.evaluate import format_table, load_model, paired_difference, summarize
     from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
 
-    if args.model is not None:
-        print(
-            f"{PROG}: warning: no learned agent of OrbitRaisingSolar-v0 is scored yet; --model ignored", file=sys.stderr
-        )
+    # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
+    loaded = load_model(args.env, args.model, warn=lambda text: print(f"{PROG}: warning: {text}", file=sys.stderr))
+    learned = {} if loaded is None else {loaded[0]: loaded[1]}
     evaluation = evaluate_solar(
         args.episodes,
         args.seed,
@@ -101,13 +100,20 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         include_dp=not args.no_dp,
         workers=args.workers,
         progress=say,
+        learned=learned,
     )
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
     table = summarize(results)
     report = solar_report(evaluation)
-    # The optimum against the best operators' rule, episode by episode.
+    # Episode by episode: the learned agent and the optimum against the best operators' rule,
+    # then the learned agent against the optimum.
     best_rule = max(SOLAR_HAND_CODED, key=lambda name: results[name].returns.mean())
-    paired = [paired_difference(results, name="dp", baseline=best_rule)] if "dp" in results else []
+    pairs = {
+        "paired_difference": paired_difference(results, name="dp", baseline=best_rule),
+        **{f"paired_{name}": paired_difference(results, name=name, baseline=best_rule) for name in learned},
+        **{f"paired_{name}_to_dp": paired_difference(results, name=name, baseline="dp") for name in learned},
+    }
+    paired = {key: pair for key, pair in pairs.items() if pair is not None}
     if args.json:
         out = {
             "env": args.env,
@@ -118,15 +124,11 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
             "policies": {name: {**row, **report["policies"][name]} for name, row in table.items()},
             **{key: value for key, value in report.items() if key != "policies"},
         }
-        if paired and paired[0] is not None:
-            out["paired_difference"] = paired[0]
+        out.update(paired)
         print(json.dumps(out))
         return 0
-    print(
-        format_table(
-            f"{args.env} ({args.solar_split} split)", args.episodes, args.seed, table, [p for p in paired if p]
-        )
-    )
+    title = f"{args.env} ({args.solar_split} split)"
+    print(format_table(title, args.episodes, args.seed, table, list(paired.values())))
     for name, row in report["policies"].items():
         print(
             f"  {name:<17} disposal burn on {row['disposal_share']:6.1%}, "
