@@ -280,7 +280,8 @@ class BestModelCallback(BaseCallback):
     Every ``every_calls`` steps of the vector env it plays one episode per
     sub-environment of ``gymnasium.make_vec(env_id, num_envs=episodes, **env_kwargs)``
     seeded with ``seed`` (`orbit_env.agents.evaluate.run_episodes`: the
-    unshaped reward, deterministic actions), logs ``eval/mean_reward`` to
+    unshaped reward, deterministic actions; on the solar task the missions of
+    `orbit_env.agents.solar.fly_model`, on the split of ``env_kwargs``), logs ``eval/mean_reward`` to
     tensorboard, saves the best so far to ``save_dir/best_model.zip`` and every
     score to ``save_dir/evaluations.json``. SB3's ``EvalCallback`` draws new
     episodes each time and would compare the policies on different starts.
