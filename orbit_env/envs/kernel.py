@@ -179,7 +179,7 @@ def _set_density_scale(data: FloatArray, k: int, scale: float) -> None:
     data[ROW.nu_per_rev, k] = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k] * scale)
 
 
-def _burn(
+def burn_row(
     data: FloatArray,
     k: int,
     requested_m_s: float,
@@ -224,9 +224,9 @@ def _burn_rows(
     b_grid: FloatArray,
     made: FloatArray,
 ) -> None:
-    """`_burn` of each of ``rows`` (asked to burn and able to), the burn made into ``made``."""
+    """`burn_row` of each of ``rows`` (asked to burn and able to), the burn made into ``made``."""
     for k in rows:
-        made[k] = _burn(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
+        made[k] = burn_row(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
 
 
 # fdlibm's reduction by pi/2 (e_rem_pio2.c: 33 bits of pi/2, and the rest) and its sine and cosine
@@ -376,7 +376,7 @@ def compiled() -> _Kernels | None:
         return None
     helpers = (grid_cell, cell, table_a_point, _relocate, _new_segment, _heights_on_segment)
     helpers += (_perigee_speed_m_s, _apogee_after_m, _sine)
-    for helper in (*helpers, _set_density_scale, _update_density, _burn):
+    for helper in (*helpers, _set_density_scale, _update_density, burn_row):
         # Callable from the compiled loops, unchanged from Python. Not inlined by numba (that took the
         # first compilation from 4.7 s to 25 s); LLVM inlines the small ones, so the loops stay SIMD.
         numba.extending.register_jitable(helper)

@@ -1,8 +1,10 @@
-"""The solar task's month of decay, its rule and its disposal burn, compiled: loops over the orbits (numba).
+"""The solar task's step, month of decay, rule and disposal burn, compiled: loops over the orbits (numba).
 
-The one implementation of `orbit_env.envs.solar_task`'s coast (`coast_block`), of the
-rule's judgement (`life_margin_days`) and of the cheapest compliant disposal burn
-(`disposal`): plain-float functions of one orbit, compiled by numba into loops over arrays
+The one implementation of `orbit_env.envs.solar_task`'s step (`step_rows`: the perigee burn,
+`orbit_env.envs.kernel.burn_row`, then the month's coast) and observation (`observe_rows`),
+of its coast (`coast_block`), of the rule's judgement (`life_margin_days`) and of the
+cheapest compliant disposal burn (`disposal`): plain-float functions of one orbit, compiled
+by numba into loops over arrays
 (with ``ORBIT_ENV_JIT=0`` the same functions run uncompiled, slowly). An orbit's month is
 a handful of table lookups; the rule at a mission's end decays it (and each candidate
 disposal) month by month over five years, which numpy spent in thousands of small calls.
@@ -28,13 +30,17 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
-from orbit_env.decay.curves import NU_REF, grid_cell
+from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
+from orbit_env.decay.curves import NU_REF
 from orbit_env.decay.drag_clock import DragClock, drag_days_at
-from orbit_env.envs.kernel import JIT_VARIABLE, cell, table_a_point, tables
+from orbit_env.envs.kernel import JIT_VARIABLE, KernelParameters, burn_row, cell, table_a_point, tables
+from orbit_env.envs.kernel import compiled as kernel_loops
+from orbit_env.envs.state import ROW, SEGMENT_ROW, STALE_SEGMENT
 
 FloatArray = NDArray[np.float64]
 
+# The places of the task's numbers in the array the loops read (`orbit_env.envs.kernel.KernelParameters`).
+_P = KernelParameters(*range(len(KernelParameters._fields)))
 #: The lowest rate W may fall at when the rule's years end with the orbit still up (per day, relative).
 MIN_RATE = 1e-9
 
@@ -47,12 +53,13 @@ class SolarTables(NamedTuple):
     b_cells: FloatArray
     b_grid: FloatArray
     cumulative: FloatArray
+    indices: FloatArray  # (4, days): the clock's `DragClock.daily_indices` as rows
 
 
 @lru_cache(maxsize=4)
 def solar_tables(clock: DragClock) -> SolarTables:
     """The tables of a drag clock (built once per clock)."""
-    return SolarTables(*tables(clock.curves), clock.cumulative_days)
+    return SolarTables(*tables(clock.curves), clock.cumulative_days, np.array(clock.daily_indices))
 
 
 def _curve_at(label: float, tau: float, b_cells: FloatArray, b_grid: FloatArray) -> tuple[float, float, float]:
@@ -328,15 +335,107 @@ def _disposal_rows(
         )
 
 
+def _step_rows(
+    data: FloatArray,
+    requested_m_s: FloatArray,
+    p: FloatArray,
+    block_days: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    made: FloatArray,
+    reward: FloatArray,
+    terminated: NDArray[np.bool_],
+    truncated: NDArray[np.bool_],
+) -> None:
+    """A step of every row of a batch's state array, in place: the perigee burn asked for, then a month's `_coast`.
+
+    The burn is `orbit_env.envs.kernel.burn_row` (the known-density task's); the reward is the
+    days lived less the propellant's cost; the ends are re-entry and the horizon's step.
+    """
+    cost, horizon = p[_P.propellant_cost_per_m_s], p[_P.horizon_steps]
+    for k in range(data.shape[1]):
+        dv = 0.0
+        if min(requested_m_s[k], data[ROW.dv_left_m_s, k]) > 0.0:
+            dv = burn_row(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
+        gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
+        day = data[ROW.start_day, k] + data[ROW.steps, k] * block_days
+        perigee, apogee = data[ROW.perigee_m, k], data[ROW.apogee_m, k]
+        lived, nu, tau, hp, ha, period, ratio = _coast(
+            data[ROW.label, k], data[ROW.nu, k], perigee, apogee, gc, day, block_days, b_cells, b_grid, cumulative
+        )
+        data[ROW.perigee_drop_m, k] = perigee - hp
+        data[ROW.apogee_drop_m, k] = apogee - ha
+        data[ROW.nu, k] = nu
+        data[ROW.tau, k] = tau
+        data[ROW.perigee_m, k] = hp
+        data[ROW.apogee_m, k] = ha
+        if nu > 0.0:
+            data[ROW.period_s, k] = period  # a re-entered orbit keeps its last period
+        data[SEGMENT_ROW, k] = STALE_SEGMENT  # the known-density task's kept cell: not this task's
+        data[ROW.density_scale, k] = ratio
+        data[ROW.time_days, k] += lived
+        steps = data[ROW.steps, k] + 1.0
+        data[ROW.steps, k] = steps
+        made[k] = dv
+        reward[k] = lived - cost * dv
+        terminated[k] = nu <= 0.0
+        truncated[k] = steps >= horizon and nu > 0.0
+
+
+def _observe_rows(
+    data: FloatArray,
+    p: FloatArray,
+    block_days: float,
+    index_scale: float,
+    indices: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+    obs: NDArray[np.float32],
+) -> None:
+    """The observation of every row into ``obs`` (n, 11): the orbit, tank, clock, predicted life; the Sun yesterday.
+
+    The predicted life is W over the last span's mean multiplier at the perigee; the Sun's
+    indices (``indices`` rows: F10.7, its 81- and 365-day means, Ap) are the day's before the
+    step's first, over ``index_scale``; each component clipped to [low, high].
+    """
+    for k in range(data.shape[1]):
+        steps = data[ROW.steps, k]
+        yesterday = int(data[ROW.start_day, k] + steps * block_days - 1.0)
+        gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
+        life = data[ROW.period_s, k] * data[ROW.nu, k] / (gc * max(data[ROW.density_scale, k], 1e-9) * SECONDS_PER_DAY)
+        apogee_drop = max(data[ROW.apogee_drop_m, k], 0.0)
+        perigee_drop = max(data[ROW.perigee_drop_m, k], 0.0)
+        values = (
+            data[ROW.perigee_m, k] * p[_P.per_height_scale_m],
+            data[ROW.apogee_m, k] * p[_P.per_height_scale_m],
+            data[ROW.dv_left_m_s, k] * p[_P.per_dv_scale_m_s],
+            min(steps / p[_P.horizon_steps], 1.0),
+            life / (life + p[_P.lifetime_scale_days]),
+            apogee_drop / (apogee_drop + p[_P.apogee_drop_scale_m]),
+            perigee_drop / (perigee_drop + p[_P.perigee_drop_scale_m]),
+            indices[0, yesterday] / index_scale,
+            indices[1, yesterday] / index_scale,
+            indices[2, yesterday] / index_scale,
+            indices[3, yesterday] / index_scale,
+        )
+        for m in range(len(values)):
+            obs[k, m] = min(max(values[m], low[m]), high[m])
+
+
 class _Loops(NamedTuple):
     """The loops over orbits (compiled, or the plain functions with ``ORBIT_ENV_JIT=0``)."""
 
     coast_rows: Any
     life_margin_rows: Any
     disposal_rows: Any
+    step_rows: Any
+    observe_rows: Any
 
 
-_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows)
+_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows, _step_rows, _observe_rows)
 
 
 @lru_cache(maxsize=1)
@@ -346,7 +445,8 @@ def loops() -> _Loops:
         return _PLAIN
     import numba
 
-    helpers = (grid_cell, cell, table_a_point, drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast)
+    kernel_loops()  # registers the known-density loops' helpers (burn_row and what it calls)
+    helpers = (drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast)
     for helper in (*helpers, _life_margin, _candidate_margin, _disposal_perigee):
         numba.extending.register_jitable(helper)
     return _Loops(*(numba.njit(cache=True, nogil=True)(loop) for loop in _PLAIN))
@@ -410,5 +510,62 @@ def disposal_perigee_rows(
     t = solar_tables(clock)
     rows = _float_rows(label, nu, perigee_m, apogee_m, gc, first_day)
     out = np.empty(rows[0].size)
-    loops().disposal_rows(*rows, float(block_days), float(horizon_days), int(candidates), *t, out)
+    loops().disposal_rows(
+        *rows,
+        float(block_days),
+        float(horizon_days),
+        int(candidates),
+        t.a_cells,
+        t.a_grid,
+        t.b_cells,
+        t.b_grid,
+        t.cumulative,
+        out,
+    )
     return out
+
+
+def step_rows(
+    t: SolarTables,
+    data: FloatArray,
+    requested_m_s: FloatArray,
+    parameters: FloatArray,
+    block_days: float,
+) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
+    """`_step_rows` of every row of a batch's state array: (burns made, reward, terminated, truncated)."""
+    n = data.shape[1]
+    made, reward = np.empty(n), np.empty(n)
+    terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    requested = np.asarray(requested_m_s, dtype=np.float64)
+    if requested.shape != (n,):
+        requested = np.full(n, float(requested))
+    loops().step_rows(
+        data,
+        requested,
+        parameters,
+        float(block_days),
+        t.a_cells,
+        t.a_grid,
+        t.b_cells,
+        t.b_grid,
+        t.cumulative,
+        made,
+        reward,
+        terminated,
+        truncated,
+    )
+    return made, reward, terminated, truncated
+
+
+def observe_rows(
+    t: SolarTables,
+    data: FloatArray,
+    parameters: FloatArray,
+    block_days: float,
+    index_scale: float,
+    bounds: FloatArray,
+) -> NDArray[np.float32]:
+    """`_observe_rows` of a batch's state array: (n, components) float32; ``bounds`` (2, components): low, high."""
+    obs = np.empty((data.shape[1], bounds.shape[1]), dtype=np.float32)
+    loops().observe_rows(data, parameters, float(block_days), float(index_scale), t.indices, bounds[0], bounds[1], obs)
+    return obs

@@ -35,7 +35,6 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from orbit_env.checks import check_number
-from orbit_env.constants import SECONDS_PER_DAY
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution
 from orbit_env.decay.drag_clock import DragClock, drag_clock
 from orbit_env.decay.solar import iso_date, unix_days
@@ -43,14 +42,9 @@ from orbit_env.envs import solar_kernel
 from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.state import STALE_SEGMENT, BatchState
 from orbit_env.envs.task import (
-    APOGEE_DROP_SCALE_M,
-    DV_SCALE_M_S,
-    HEIGHT_SCALE_M,
-    LIFETIME_SCALE_DAYS,
     OBS_NAMES,
-    PERIGEE_DROP_SCALE_M,
     Task,
-    burn,
+    kernel_parameters,
     place,
     update_satellite,
 )
@@ -102,6 +96,7 @@ SOLAR_OBS_INDEX = {name: i for i, name in enumerate(SOLAR_OBS_NAMES)}
 SOLAR_INDEX_SCALE = 100.0
 SOLAR_OBS_LOW = np.zeros(len(SOLAR_OBS_NAMES), dtype=np.float32)
 SOLAR_OBS_HIGH = np.array([1.2, 5.0, 3.0, 1.0, 1.0, 1.0, 1.0, 5.0, 5.0, 5.0, 5.0], dtype=np.float32)
+_BOUNDS = np.array([SOLAR_OBS_LOW, SOLAR_OBS_HIGH], dtype=np.float64)  # as the compiled observation reads them
 
 
 @dataclass(frozen=True)
@@ -162,6 +157,16 @@ class SolarTask(Task):
     def clock(self) -> DragClock:
         """The drag clock of the mission's orbit plane."""
         return drag_clock(self.mission.inclination_deg)
+
+    @cached_property
+    def tables(self) -> solar_kernel.SolarTables:
+        """The tables the compiled loops read (the clock's curves and drag-days)."""
+        return solar_kernel.solar_tables(self.clock)
+
+    @cached_property
+    def kernel_parameters(self) -> FloatArray:
+        """The task's numbers as the compiled loops read them (`orbit_env.envs.task.kernel_parameters`)."""
+        return kernel_parameters(self)
 
     @cached_property
     def curves(self) -> UniversalCurves:  # type: ignore[override]
@@ -344,32 +349,6 @@ def coast_block(
     return Coast(*(row.reshape(shape) for row in rows))
 
 
-def coast(task: SolarTask, state: BatchState) -> FloatArray:
-    """One step's decay (`coast_block` over `SolarMission.block_days`), in place; return the days lived."""
-    block = task.mission.block_days
-    after = coast_block(
-        task.clock,
-        state.label,
-        state.nu,
-        state.perigee_m,
-        state.apogee_m,
-        drag_rate(state),
-        today(task, state),
-        float(block),
-    )
-    state.perigee_drop_m = state.perigee_m - after.perigee_m
-    state.apogee_drop_m = state.apogee_m - after.apogee_m
-    state.nu = after.nu
-    state.tau = after.tau
-    state.perigee_m, state.apogee_m = after.perigee_m, after.apogee_m
-    state.period_s = np.where(after.nu > 0.0, after.period_s, state.period_s)
-    state.segments[0] = STALE_SEGMENT
-    state.density_scale = after.ratio
-    state.time_days += after.lived_days
-    state.steps += 1.0
-    return after.lived_days
-
-
 def life_margin_days(
     task: SolarTask,
     label: FloatArray,
@@ -429,12 +408,10 @@ def step(task: SolarTask, state: BatchState, requested_dv_m_s: Any) -> SolarStep
         The reward (days in orbit during the step, minus ``propellant_cost_per_m_s`` times the
         burn, and at the end times the disposal burn, or the penalty), the ends and the burns.
     """
-    dv = burn(task, state, requested_dv_m_s)
-    days = coast(task, state)
+    dv, reward, terminated, truncated = solar_kernel.step_rows(
+        task.tables, state.data, requested_dv_m_s, task.kernel_parameters, float(task.mission.block_days)
+    )
     cost = task.config.propellant_cost_per_m_s
-    reward = days - cost * dv
-    terminated = state.nu <= 0.0
-    truncated = (state.steps >= task.config.horizon_steps) & ~terminated
     disposal_m_s = np.zeros(state.size)
     complies = np.ones(state.size, dtype=bool)
     ending = np.flatnonzero(truncated)
@@ -463,29 +440,11 @@ def observe(task: SolarTask, state: BatchState) -> NDArray[np.float32]:
     The Sun as observed up to the day before the step's first day (F10.7, its trailing 81-
     and 365-day means, Ap); the predicted lifetime is W over the last month's mean multiplier
     at the perigee (what the orbit's observed decay says), held at the mission's start by the
-    month before it.
+    month before it. Compiled (`orbit_env.envs.solar_kernel`).
     """
-    f107, f81, f365, ap = task.clock.daily_indices
-    yesterday = (today(task, state) - 1.0).astype(np.intp)
-    gc = drag_rate(state)
-    weighted = state.period_s * state.nu
-    life_days = weighted / (gc * np.maximum(state.density_scale, 1e-9) * SECONDS_PER_DAY)
-    clock = np.minimum(state.steps / task.config.horizon_steps, 1.0)
-    columns = (
-        state.perigee_m / HEIGHT_SCALE_M,
-        state.apogee_m / HEIGHT_SCALE_M,
-        state.dv_left_m_s / DV_SCALE_M_S,
-        clock,
-        life_days / (life_days + LIFETIME_SCALE_DAYS),
-        np.maximum(state.apogee_drop_m, 0.0) / (np.maximum(state.apogee_drop_m, 0.0) + APOGEE_DROP_SCALE_M),
-        np.maximum(state.perigee_drop_m, 0.0) / (np.maximum(state.perigee_drop_m, 0.0) + PERIGEE_DROP_SCALE_M),
-        f107[yesterday] / SOLAR_INDEX_SCALE,
-        f81[yesterday] / SOLAR_INDEX_SCALE,
-        f365[yesterday] / SOLAR_INDEX_SCALE,
-        ap[yesterday] / SOLAR_INDEX_SCALE,
+    return solar_kernel.observe_rows(
+        task.tables, state.data, task.kernel_parameters, float(task.mission.block_days), SOLAR_INDEX_SCALE, _BOUNDS
     )
-    obs = np.array(columns, dtype=np.float32).T
-    return np.clip(obs, SOLAR_OBS_LOW, SOLAR_OBS_HIGH)
 
 
 def date_of(task: SolarTask, day: float) -> str:
