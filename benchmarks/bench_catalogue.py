@@ -33,10 +33,12 @@ import numpy as np
 
 from orbit_env import cache
 from orbit_env.analysis.air import MsisAir
-from orbit_env.analysis.catalogue import batch_lifetimes, read_batch, write_records
+from orbit_env.analysis.catalogue import batch_lifetimes
+from orbit_env.analysis.catalogue_io import read_batch, write_records
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.decay import chunked
-from orbit_env.decay.chunked import cached_curves, log_density_slope_per_m
+from orbit_env.decay.chunked import cached_curves
+from orbit_env.decay.density_multiplier import log_density_slope_per_m
 from orbit_env.decay.solar import ConstantActivity, unix_days
 from orbit_env.decay.solar_record import load_record
 from orbit_env.physics.atmosphere.msis import _cached_log_density_table

@@ -18,8 +18,9 @@ from collections.abc import Callable
 
 from orbit_env import cache
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
-from orbit_env.decay.chunked import SolarDecayModel, cached_curves, integrate_reference, propagate
+from orbit_env.decay.chunked import SolarDecayModel, cached_curves, propagate
 from orbit_env.decay.direct import integrate_direct
+from orbit_env.decay.reference_path import integrate_reference
 from orbit_env.decay.solar import CycleActivity, unix_days
 from orbit_env.physics.atmosphere.msis import MsisAtmosphere, _cached_log_density_table
 

@@ -20,7 +20,8 @@ import time
 
 import numpy as np
 
-from orbit_env.decay.chunked import SolarDecayModel, cached_curves, integrate_reference, propagate
+from orbit_env.decay.chunked import SolarDecayModel, cached_curves, propagate
+from orbit_env.decay.reference_path import integrate_reference
 from orbit_env.decay.solar import CycleActivity, TableActivity, unix_days
 
 #: Starts a week or so before a storm (its day in the comment), and quiet spells.

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 
-from orbit_env.analysis import catalogue
+from orbit_env.analysis import catalogue, catalogue_io
 from orbit_env.analysis.lifetime import Satellite, lifetime
 from orbit_env.cli import main
 from orbit_env.cli.common import check_finite
@@ -95,7 +95,7 @@ def test_batch_never_replaces_its_input_or_an_existing_file_unasked(capsys, tmp_
     def never(*args, **kwargs):
         raise AssertionError("the batch was computed before its output was checked")
 
-    monkeypatch.setattr(catalogue, "read_batch", never)
+    monkeypatch.setattr(catalogue_io, "read_batch", never)
     monkeypatch.setattr(catalogue, "batch_lifetimes", never)
     missing = tmp_path / "no-such-folder" / "out.csv"
     status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", missing, "--no-progress")
@@ -111,7 +111,7 @@ def test_batch_output_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
 
     monkeypatch.setattr(csv.DictWriter, "writerows", disk_full)
     with pytest.raises(OSError, match="No space left"):
-        catalogue.write_records(out, [{"perigee_km": "300", "status": "ok"}])
+        catalogue_io.write_records(out, [{"perigee_km": "300", "status": "ok"}])
     assert out.read_text() == "earlier results\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]  # no temporary file left behind
 

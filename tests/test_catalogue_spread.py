@@ -6,14 +6,10 @@ import pytest
 pytest.importorskip("pymsis")
 
 from orbit_env.analysis.air import MsisAir, PaperAir
-from orbit_env.analysis.catalogue import (
-    PATH_NODES,
-    SPREAD_MAX_SPAN_M,
-    _spread_days,
-    batch_lifetimes,
-    inclination_log_ratio,
-)
+from orbit_env.analysis.catalogue import batch_lifetimes
+from orbit_env.analysis.inclination_spread import PATH_NODES, _spread_days, inclination_log_ratio
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.decay.density_multiplier import SPREAD_MAX_SPAN_M
 from orbit_env.decay.solar import ConstantActivity
 
 #: The accuracy the docs state for the curves against the averaged ODE in NRLMSIS (0.5%); the one-family

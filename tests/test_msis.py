@@ -193,7 +193,8 @@ def test_the_days_ratios_in_one_call_equal_each_days_own(follow_season):
 )
 def test_twelve_day_lives_in_storms_within_half_a_percent_of_the_daily_reference(date, perigee_km, apogee_km):
     pytest.importorskip("pymsis")
-    from orbit_env.decay.chunked import SolarDecayModel, integrate_reference, propagate
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+    from orbit_env.decay.reference_path import integrate_reference
     from orbit_env.decay.solar import unix_days
     from orbit_env.decay.solar_record import load_record
 

@@ -87,7 +87,8 @@ def test_a_satellites_bins_do_not_depend_on_the_others_in_the_vector(msis):
 
 
 def test_chunked_matches_the_daily_reference_under_storms(msis):
-    from orbit_env.decay.chunked import SolarDecayModel, integrate_reference, propagate
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+    from orbit_env.decay.reference_path import integrate_reference
 
     # Daily rows: F10.7 with a 27-day rotation of +-20% and random storms in Ap.
     rng = np.random.default_rng(3)

@@ -7,7 +7,9 @@ pytest.importorskip("pymsis")
 
 from orbit_env.analysis.lifetime import Satellite, lifetime
 from orbit_env.decay.averaged import DecayModel
-from orbit_env.decay.chunked import SolarDecayModel, integrate_reference, orbit_ratio, propagate
+from orbit_env.decay.chunked import SolarDecayModel, propagate
+from orbit_env.decay.density_multiplier import orbit_ratio
+from orbit_env.decay.reference_path import integrate_reference
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import load_record
 from orbit_env.physics.atmosphere import ExponentialAtmosphere

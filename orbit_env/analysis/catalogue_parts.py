@@ -36,7 +36,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from orbit_env.analysis.catalogue import atomic_text, write_records
+from orbit_env.analysis.catalogue_io import atomic_text, write_records
 
 #: A chunk's rows at most: on the time-stepped path (a dated air, 1000 samples of a 13-year life take
 #: about 36 s a row), so a stopped run loses minutes, not hours; on a fixed profile (milliseconds a row).

@@ -26,7 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from orbit_env.analysis.catalogue import BatchOrbits, batch_lifetimes, format_value
+from orbit_env.analysis.catalogue import batch_lifetimes
+from orbit_env.analysis.catalogue_io import BatchOrbits, format_value
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.analysis.uncertainty import PERCENTILES, lifetime_spread, spread_report
 

@@ -19,7 +19,7 @@ from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_cur
 from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
-from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate, reference_path
+from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate
 from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
     CURVES_MAX_PERIGEE_M,
@@ -28,6 +28,7 @@ from orbit_env.decay.curves import (
     days_from_weighted_s,
     universal_curves,
 )
+from orbit_env.decay.reference_path import reference_path
 from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, as_atmosphere
 from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km

@@ -206,7 +206,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
     from concurrent.futures.process import BrokenProcessPool
 
-    from orbit_env.analysis.catalogue import batch_lifetimes, check_output, write_records
+    from orbit_env.analysis.catalogue import batch_lifetimes
+    from orbit_env.analysis.catalogue_io import check_output, write_records
     from orbit_env.analysis.catalogue_parts import parts_folder
 
     if not args.out:

@@ -26,7 +26,7 @@ from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.cli.common import given, number
 
 if TYPE_CHECKING:
-    from orbit_env.analysis.catalogue import BatchOrbits
+    from orbit_env.analysis.catalogue_io import BatchOrbits
 
 #: What ``drag_parameter_source`` says in JSON.
 SOURCE_BSTAR = "bstar"
@@ -387,7 +387,7 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
     """
     import numpy as np
 
-    from orbit_env.analysis.catalogue import BatchOrbits, read_batch
+    from orbit_env.analysis.catalogue_io import BatchOrbits, read_batch
     from orbit_env.analysis.drag_calibration import calibrate, fit_history
     from orbit_env.analysis.elements import looks_like_tle, read_tle
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from orbit_env.analysis.catalogue import BatchOrbits
+from orbit_env.analysis.catalogue_io import BatchOrbits
 from orbit_env.analysis.catalogue_parts import JoinedParts, chunk_rows, fingerprint, require_ray, run_in_parts
 from orbit_env.analysis.catalogue_uncertainty import uncertain_lifetimes
 from orbit_env.analysis.scenario import Scenario

@@ -7,13 +7,13 @@ chunk's 81-day F10.7 in steps of ``bin_step`` in ln F10.7, its Ap on a coarse lo
 year-averaged; each bin built once and cached), and what the bin leaves out (every day's
 indices, the season) is a density multiplier s: the chunk's mean of the daily densities over the
 bin's, taken over the orbit as drag weights it (`orbit_ratio`; near re-entry from the averaged
-equations' rates, `SolarDecayModel.weight_of`). The satellite moves along its curve by the
+equations' rates, `orbit_env.decay.density_multiplier.life_rate_ratio`). The satellite moves along its curve by the
 chunk's time (W = Int P dnu falls by dt g c s); near re-entry a chunk goes a day, then a quarter
 day, at a time (`FINE_CHUNKS`, `FINISH_STEP_DAYS`, `LAST_DAYS`). Satellites are re-located on the
 curves only when the bin changes; everything is vectorized over satellites.
 
 Why each choice, and its measured effect against a day-by-day integration of the averaged
-equations (`integrate_reference`): docs/validation-modern/solar-activity.md.
+equations (`orbit_env.decay.reference_path.integrate_reference`): docs/validation-modern/solar-activity.md.
 """
 
 from __future__ import annotations
@@ -22,35 +22,38 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_number
 from orbit_env.constants import (
-    EARTH_RADIUS_M,
-    EARTH_ROTATION_RAD_S,
     G0_M_S2,
-    MU_EARTH_M3_S2,
     REENTRY_ALTITUDE_M,
     SECONDS_PER_DAY,
 )
-from orbit_env.decay.averaged import DecayModel, kernel_rates
+from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.daily_air import DailyAirTable, daily_air_table
+from orbit_env.decay.density_multiplier import (
+    SPREAD_MAX_SPAN_M,
+    SPREAD_QUADRATURE_POINTS,
+    corotation_factor,
+    inclination_anchors,
+    inclination_basis,
+    interpolate_rows,
+    life_rate_ratio,
+    log_density_slope_per_m,
+    orbit_ratio,
+)
 from orbit_env.decay.solar import SolarActivity, day_of_year
-from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
     DEFAULT_MSIS_VERSION,
     SEASON_NODES,
     MsisAtmosphere,
     check_msis_version,
-    interpolate_log_density,
-    mean_density_kg_m3,
 )
-from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -64,10 +67,6 @@ FINISH_STEP_DAYS = 1.0
 LAST_DAYS = 4.0
 #: Steps a day in the last `LAST_DAYS` days.
 LAST_STEPS = 4
-#: Steps of the forward differences of W (the life left on a bin's curves) in p [m] and in e: halved or
-#: multiplied by 4, the 120 km wide short lives of docs/validation-modern.md move by at most 0.03%.
-GRADIENT_STEP_P_M = 500.0
-GRADIENT_STEP_E = 5e-5
 #: A chunk goes in daily sub-steps when less than this many chunks of decay (at the chunk's rate) are left.
 FINE_CHUNKS = 3.0
 #: Default cap on the time propagated [years]; a satellite still up then is reported as such.
@@ -89,25 +88,13 @@ NEAR_CIRCULAR_SPAN_M = 20e3
 NEAR_CIRCULAR_BIN_STEP = 0.3
 #: Ap values of near-circular orbits' bins.
 NEAR_CIRCULAR_AP_BINS = (3.0, 12.0, 48.0, 192.0)
-#: Widest orbit [m] (apogee - perigee height) of another inclination than the family's that takes the density ratio
-#: over the orbit; wider ones the ratio of the life's rates (one multiplier moves the perigee and the eccentricity
-#: alike: docs/validation-modern.md, section 7).
-SPREAD_MAX_SPAN_M = 100e3
-#: Anomalies of those wider orbits' rates (a ratio of two averages on the same nodes; on 10^4 rows 100-1500 km wide,
-#: 8 leave up to 0.96% against a family per inclination at 200 km perigees, 12 and 16 0.43%).
-SPREAD_QUADRATURE_POINTS = 12
 #: Those wider orbits' ratio of the life's rates is recomputed when the perigee has moved this far [m] (or the bin
 #: changed), and held in between as a factor on the ratio over the orbit.
 SPREAD_REFRESH_M = 5e3
-#: Inclinations [deg] at which the NRLMSIS density of other inclinations is computed (a spline between).
-ANCHOR_STEP_DEG = 10.0
 #: Heights at which the exact/bin density ratio is tabulated [m].
 RATIO_GRID_M = np.arange(100e3, 1200e3 + 1.0, 50e3)
 #: Latitude and local-time nodes of the ratio (both profiles sampled alike).
 RATIO_NODES = {"latitude_nodes": 6, "local_time_nodes": 6}
-#: Rows of `life_rate_ratio` computed together (its kernels, 3 air speeds x 33 steps x 7 anomalies a
-#: row in a co-rotating spread catalogue, stay in the cache instead of fresh pages of 100 MB).
-RATE_BLOCK_ROWS = 1000
 
 #: Days [d] whose air is computed together when a chunk meets a day the air table does not hold yet
 #: (`orbit_env.decay.daily_air`): one NRLMSIS call of half a year instead of one per chunk.
@@ -184,154 +171,6 @@ def _log_bin_density(
     keys = [(binned[0], binned[0], binned[1], float(doy)) for doy in season]
     log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(keys)
     return np.log(np.exp(log_rho).mean(axis=0))
-
-
-@lru_cache(maxsize=256)
-def log_density_slope_per_m(atmosphere: MsisAtmosphere) -> FloatArray:
-    """The log-slope d ln(density)/dh [1/m] of a bin's profile on ``ALTITUDE_GRID_M`` (the table its curves use)."""
-    return np.gradient(atmosphere.log_density_table(), ALTITUDE_GRID_M)
-
-
-def orbit_ratio(
-    ratio_at_perigee: ArrayLike,
-    log_ratio_slope_per_m: ArrayLike,
-    log_density_slope_per_m: ArrayLike,
-    perigee_m: ArrayLike,
-    apogee_m: ArrayLike,
-) -> FloatArray:
-    """The density multiplier of an orbit: a ratio of densities r(h), averaged as drag weights the orbit.
-
-    With the density locally exponential about the perigee (log-slope
-    ``log_density_slope_per_m`` = -1/H) and r likewise (log-slope beta), the
-    orbit average of drag to first order in e is King-Hele's
-    rho_p e^-x (I0(x) + 2 e I1(x)), x = a e / H (D. G. King-Hele, *Theory of
-    Satellite Orbits in an Atmosphere*, 1964, ch. 4). The multiplier is that
-    average under rho r over that under rho: r(h_p) B(x (1 - beta H)) / B(x).
-    Circular orbits (x = 0) take r(h_p). Arrays broadcast.
-    """
-    from scipy.special import i0e, i1e  # on use: a third of a second of start-up
-
-    hp, ha = np.asarray(perigee_m, dtype=np.float64), np.asarray(apogee_m, dtype=np.float64)
-    ae_m = 0.5 * (ha - hp)
-    e = ae_m / (2.0 * EARTH_RADIUS_M + hp + ha)
-    inverse_h = np.maximum(-np.asarray(log_density_slope_per_m, dtype=np.float64), 0.0)
-    x0 = ae_m * inverse_h
-    x1 = ae_m * (inverse_h - np.asarray(log_ratio_slope_per_m, dtype=np.float64))
-
-    def weight(x: FloatArray) -> FloatArray:
-        # e^-x (I0(x) + 2 e I1(x)) from the scaled Bessel functions (e^-|x| I(|x|)); x < 0 only for a
-        # ratio steeper than the density (not seen in NRLMSIS, kept finite all the same).
-        ax = np.abs(x)
-        return np.exp(ax - x) * (i0e(ax) + 2.0 * e * np.sign(x) * i1e(ax))
-
-    return np.asarray(ratio_at_perigee, dtype=np.float64) * weight(x1) / weight(x0)
-
-
-def interpolate_rows(table: FloatArray, grid_m: FloatArray, height_m: FloatArray) -> FloatArray:
-    """Row k of ``height_m`` (any trailing shape) interpolated linearly in row k of ``table`` (rows, heights).
-
-    ``grid_m`` is uniform (the rows' tables are read by index); heights beyond it take
-    its end values, as ``np.interp``. A table of one row serves every row of ``height_m``.
-    """
-    return interpolate_rows_with_slope(table, grid_m, height_m)[0]
-
-
-def interpolate_rows_with_slope(
-    table: FloatArray, grid_m: FloatArray, height_m: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """`interpolate_rows`, and the slope of the table's cell each height falls in [1/m]."""
-    h = np.asarray(height_m, dtype=np.float64)
-    dh = float(grid_m[1] - grid_m[0])
-    x = np.clip((h - grid_m[0]) / dh, 0.0, grid_m.size - 1.000001)
-    cell = x.astype(np.intp)
-    rows = 0 if table.shape[0] == 1 else np.arange(table.shape[0]).reshape(-1, *([1] * (h.ndim - 1)))
-    low, high = table[rows, cell], table[rows, cell + 1]
-    return np.asarray(low + (x - cell) * (high - low), dtype=np.float64), np.asarray((high - low) / dh)
-
-
-def corotation_factor(
-    perigee_m: FloatArray, apogee_m: FloatArray, inclination_deg: ArrayLike, reference_deg: float
-) -> FloatArray:
-    """Drag in co-rotating air at each orbit's inclination over that at ``reference_deg``, at the perigee.
-
-    ((v_p - Omega r_p cos i) / (v_p - Omega r_p cos i_ref))^2: the air's speed along
-    the orbit at the perigee, where near-circular orbits meet most of their drag.
-    ``inclination_deg`` broadcasts against the heights.
-    """
-    p, e = elements_from_heights(perigee_m, apogee_m)
-    v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
-    wind = EARTH_ROTATION_RAD_S * (EARTH_RADIUS_M + perigee_m)
-    cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
-    return np.asarray(((v_p - wind * cos_i) / (v_p - wind * math.cos(math.radians(reference_deg)))) ** 2)
-
-
-def life_rate_ratio(
-    curves: UniversalCurves,
-    log_ratio: FloatArray,
-    grid_m: FloatArray,
-    perigee_m: FloatArray,
-    apogee_m: FloatArray,
-    *,
-    quadrature_points: int,
-    inclination_deg: FloatArray | None = None,
-    weighted: FloatArray | None = None,
-) -> FloatArray:
-    """dW/dnu under each row's air over the same under the air of ``curves``, at orbits on those curves.
-
-    W is the life left on ``curves`` (times g c; ``weighted``, if known, its value at the
-    orbits). Row k's air is the curves' density times exp(``log_ratio[k]``) (on the uniform
-    ``grid_m``; a table of one row serves all). The orbit stays on the curves, so what
-    must be right is how fast W falls: W_p p' + W_e e' with the averaged equations'
-    rates p', e' (``quadrature_points`` anomalies) under the row's air over the same
-    under the curves' own; one density multiplier at the perigee (`orbit_ratio`) would
-    move p and e alike, where a profile of another shape moves the eccentricity
-    otherwise. The gradient of W by forward differences (`GRADIENT_STEP_P_M`,
-    `GRADIENT_STEP_E`), towards higher perigees. In co-rotating air with
-    ``inclination_deg`` (one per row), the air's speed (Omega r cos i) enters the rates
-    nonlinearly but smoothly (Omega r / v < 0.07): rates at cos i = 0 and 1, and each
-    row's cos i on the line through them; without, the curves' inclination. Heights
-    have shape (rows, ...).
-    """
-    if np.ndim(perigee_m) and len(perigee_m) > RATE_BLOCK_ROWS:  # blocks of rows: arrays that stay in cache
-        return np.concatenate(
-            [
-                life_rate_ratio(
-                    curves,
-                    log_ratio if log_ratio.shape[0] == 1 else log_ratio[rows],
-                    grid_m,
-                    perigee_m[rows],
-                    apogee_m[rows],
-                    quadrature_points=quadrature_points,
-                    inclination_deg=None if inclination_deg is None else inclination_deg[rows],
-                    weighted=None if weighted is None else weighted[rows],
-                )
-                for rows in (slice(k, k + RATE_BLOCK_ROWS) for k in range(0, len(perigee_m), RATE_BLOCK_ROWS))
-            ]
-        )
-    model = curves.model
-    reference = model.atmosphere
-    p, e = elements_from_heights(perigee_m, apogee_m)
-    e = np.maximum(e, 0.0)
-    own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
-    rows_turn = model.rotating_atmosphere and inclination_deg is not None
-    # The air's speeds: the curves' own, and for rows at their inclinations cos i = 0 and 1.
-    air_rad_s = (own.corotation_rad_s, 0.0, EARTH_ROTATION_RAD_S) if rows_turn else (own.corotation_rad_s,)
-    height_m, k_p, k_e = own.drag_kernels_in_air(p, e, air_rad_s)
-    rho_ref = reference.density_kg_m3(height_m)
-    # Heights (rows, ..., anomalies): each row reads its own table.
-    rho_row = rho_ref * np.exp(interpolate_rows(log_ratio, grid_m, height_m))
-    dp_ref, de_ref = kernel_rates(k_p[0], k_e[0], rho_ref)
-    if rows_turn:  # each row's cos i on the line through the rates at cos i = 0 and 1
-        cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
-        cos_i = cos_i.reshape(-1, *((1,) * (np.ndim(perigee_m) - 1)))
-        (dp_90, dp_0), (de_90, de_0) = kernel_rates(k_p[1:], k_e[1:], rho_row)
-        dp_row, de_row = (1.0 - cos_i) * dp_90 + cos_i * dp_0, (1.0 - cos_i) * de_90 + cos_i * de_0
-    else:  # the rows' air moves as the curves' (still, or at their inclination)
-        dp_row, de_row = kernel_rates(k_p[0], k_e[0], rho_row)
-    w0 = SolarDecayModel.weight_of(curves, p, e) if weighted is None else weighted
-    w_p = (SolarDecayModel.weight_of(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
-    w_e = (w0 - SolarDecayModel.weight_of(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
-    return np.asarray((w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref), dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -445,11 +284,6 @@ class SolarDecayModel:
             self.ascending_node_local_time_h,
             self.version,
         )
-
-    @staticmethod
-    def weight_of(curves: UniversalCurves, p_m: FloatArray, e: FloatArray) -> FloatArray:
-        """W left (`orbit_env.decay.curves.CurvePoint.weighted_s`) of the orbits (p, e) on ``curves``."""
-        return np.asarray(curves.locate(*heights_from_elements(p_m, e)).weighted_s, dtype=np.float64)
 
     def log_ratio(self, daily: DailyIndices, binned: tuple[float, float]) -> FloatArray:
         """ln(the mean density over ``daily`` / the bin's) on `RATIO_GRID_M` (cached)."""
@@ -582,27 +416,6 @@ def _anchor_log_density(
     return np.log(rho)
 
 
-def inclination_anchors(inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
-    """Every `ANCHOR_STEP_DEG` spanning ``inclination_deg`` and ``reference_deg`` [deg] (one, if they all agree)."""
-    low = math.floor(min(float(np.min(inclination_deg)), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
-    high = math.ceil(max(float(np.max(inclination_deg)), reference_deg) / ANCHOR_STEP_DEG) * ANCHOR_STEP_DEG
-    return np.arange(low, high + 0.5 * ANCHOR_STEP_DEG, ANCHOR_STEP_DEG)
-
-
-def inclination_basis(anchors_deg: FloatArray, inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
-    """B (satellites, anchors): B @ f(anchors) is f(i) - f(reference) of the cubic spline through them.
-
-    The interpolating spline is linear in its data, so its basis, the splines of the
-    unit vectors, turns a table at the anchors into values at the inclinations in one
-    product. Zero rows at the reference.
-    """
-    from scipy.interpolate import make_interp_spline  # on use: half a second of start-up
-
-    spline = make_interp_spline(anchors_deg, np.eye(anchors_deg.size), k=min(3, anchors_deg.size - 1), axis=0)
-    at = np.asarray(spline(np.asarray(inclination_deg, dtype=np.float64)), dtype=np.float64)
-    return at - np.asarray(spline(reference_deg), dtype=np.float64)[None, :]
-
-
 @dataclass(frozen=True)
 class SolarLifetime:
     """Result of `propagate`, arrays over satellites.
@@ -641,7 +454,7 @@ def _daily_steps(
     """The chunk from ``t0`` a day (`FINISH_STEP_DAYS`) at a time, for satellites near re-entry.
 
     Each step takes the density multiplier at its orbit of the profile at its middle: the
-    daily profiles' logarithms interpolated linearly in time, as `integrate_reference`
+    daily profiles' logarithms interpolated linearly in time, as `orbit_env.decay.reference_path.integrate_reference`
     does. A satellite with less than `LAST_DAYS` left at the day's rate goes through
     the day in `LAST_STEPS` steps. Returns the re-entry day (NaN for a satellite still
     up at the chunk's end), nu and the heights at the chunk's end (or at re-entry), and
@@ -964,111 +777,3 @@ def _propagate(
         history_apogee_m=np.array(history_ha),
         bins_used=len(bins),
     )
-
-
-def integrate_reference(
-    perigee_m: float,
-    apogee_m: float,
-    drag_parameter_m2_kg: float,
-    model: SolarDecayModel,
-    *,
-    profile_step_days: float = 1.0,
-    rtol: float = 1e-8,
-) -> float:
-    """Days to re-entry from the averaged equations in time, with a fresh NRLMSIS profile every step.
-
-    The reference for the chunked curves: no bins, no chunks, no curves. The
-    profile (orbit-averaged NRLMSIS at the day's indices and day of year) is
-    recomputed every ``profile_step_days`` and its logarithm interpolated
-    linearly in time; dp/dt and de/dt are the averaged rates of
-    `orbit_env.decay.averaged` times dnu/dt = g c / P. Slow: ~25 ms per profile.
-    """
-    solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
-    if solution.status != 1:
-        return model.max_years * 365.25
-    return float(solution.t_events[0][0]) / SECONDS_PER_DAY
-
-
-def _solve_reference(
-    perigee_m: float,
-    apogee_m: float,
-    drag_parameter_m2_kg: float,
-    model: SolarDecayModel,
-    profile_step_days: float,
-    rtol: float,
-) -> Any:
-    """The ``solve_ivp`` solution behind `integrate_reference` and `reference_path`."""
-    profiles: dict[int, FloatArray] = {}
-
-    def log_profile(index: int) -> FloatArray:
-        if index not in profiles:
-            t_days = index * profile_step_days
-            f107, f107a, ap = (float(x) for x in model.activity.indices(model.start_days + t_days))
-            doy = float(day_of_year(model.start_days + t_days)) if model.follow_season else None
-            rho = mean_density_kg_m3(
-                ALTITUDE_GRID_M,
-                f107,
-                f107a,
-                ap,
-                model.inclination_deg,
-                doy,
-                model.ascending_node_local_time_h,
-                version=model.version,
-            )
-            profiles[index] = np.log(rho)
-        return profiles[index]
-
-    def rhs(t_s: float, state: FloatArray) -> list[float]:
-        p, e = state[0], max(state[1], 0.0)
-        x = t_s / SECONDS_PER_DAY / profile_step_days
-        i = math.floor(x)
-        w = x - i
-        log_rho = (1.0 - w) * log_profile(i) + w * log_profile(i + 1)
-        atmosphere = FunctionAtmosphere(lambda h, table=log_rho: interpolate_log_density(h, table))
-        decay = DecayModel(atmosphere, model.rotating_atmosphere, model.inclination_deg)
-        with np.errstate(invalid="ignore"):  # trial steps past re-entry; the event stops before them
-            dp_dnu, de_dnu = decay.rates_per_nu(p, e)
-            dnu_dt = G0_M_S2 * drag_parameter_m2_kg / float(period_s(p, e))
-        return [float(dp_dnu) * dnu_dt, float(de_dnu) * dnu_dt]
-
-    def reentry(t_s: float, state: FloatArray) -> float:
-        return float(heights_from_elements(state[0], max(state[1], 0.0))[0]) - REENTRY_ALTITUDE_M
-
-    reentry.terminal = True  # type: ignore[attr-defined]
-    p0, e0 = (float(x) for x in elements_from_heights(perigee_m, apogee_m))
-    t_max = model.max_years * 365.25 * SECONDS_PER_DAY
-    from scipy.integrate import solve_ivp  # on use: half a second of start-up
-
-    solution = solve_ivp(
-        rhs,
-        (0.0, t_max),
-        [p0, e0],
-        method="DOP853",
-        events=reentry,
-        rtol=rtol,
-        atol=[1e-3, 1e-12],
-        max_step=profile_step_days * SECONDS_PER_DAY,
-    )
-    return solution
-
-
-def reference_path(
-    perigee_m: float,
-    apogee_m: float,
-    drag_parameter_m2_kg: float,
-    model: SolarDecayModel,
-    *,
-    profile_step_days: float = 1.0,
-    rtol: float = 1e-8,
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The decay of `integrate_reference` as it goes: days, perigee [m] and apogee [m] at its steps.
-
-    The last point is the re-entry (perigee 100 km), or the state at ``max_years``.
-    """
-    solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
-    t_s, states = solution.t, solution.y.T
-    if solution.status == 1:
-        t_s = np.append(t_s[t_s < solution.t_events[0][0]], solution.t_events[0][0])
-        states = np.vstack([states[: t_s.size - 1], solution.y_events[0][:1]])
-    perigee, apogee = heights_from_elements(states[:, 0], np.maximum(states[:, 1], 0.0))
-    return t_s / SECONDS_PER_DAY, np.asarray(perigee, dtype=np.float64), np.asarray(apogee, dtype=np.float64)
