@@ -2,7 +2,10 @@
 
 Each trial trains one Stable-Baselines3 algorithm with one seed on the numpy vector
 environment, saves the model and scores it on the evaluation episodes of
-``orbit-env evaluate`` (the plain reward; capture against the DP optimum, as there).
+``orbit-env evaluate`` (the plain reward; capture against the DP optimum, as there). On
+``OrbitRaisingSolar-v0`` that is the solar evaluation (`orbit_env.agents.solar.evaluate_solar`):
+trained on the train split, scored on the missions of the held-out test split, the capture
+between never burning and the per-episode DP.
 The trials run on Ray Tune (``pip install 'orbit-env[cluster]'``): a local Ray by
 default, a cluster by its address. A sweep interrupted in the middle continues where
 it stopped when run again with the same ``--out`` (finished trials are kept).
@@ -43,7 +46,10 @@ RECIPES = {
     "OrbitRaising-v0": "ppo.toml",
     "OrbitRaisingUncertain-v0": "ppo_uncertain.toml",
     "OrbitRaisingContinuous-v0": "ppo_continuous.toml",
+    "OrbitRaisingSolar-v0": "ppo_solar.toml",
 }
+#: The split the solar task's trials are scored on: the held-out one of ``orbit-env evaluate``.
+SOLAR_EVAL_SPLIT = "test"
 #: Satellites stepped together in a trial with SB3's defaults.
 SWEEP_NUM_ENVS = 16
 #: Bootstrap resamples of the confidence intervals.
@@ -142,14 +148,23 @@ def train_trial(
 
 
 def run_trial(config: dict[str, Any]) -> dict[str, Any]:
-    """One trial (Ray Tune's function trainable): train, then score on the evaluation episodes."""
+    """One trial (Ray Tune's function trainable): train, then score on the evaluation episodes.
+
+    The solar task's trials fly the missions of ``config["solar_split"]``, as `orbit_env.agents.solar.evaluate_solar`.
+    """
     from orbit_env.agents.evaluate import load_model, run_episodes
 
     start = time.perf_counter()
+    env_id, episodes, eval_seed = config["env_id"], int(config["episodes"]), int(config["eval_seed"])
     trial_dir = Path(config["out"]) / "trials" / f"{config['algo']}_seed{config['seed']}"
-    path = train_trial(config["env_id"], config["algo"], int(config["seed"]), int(config["timesteps"]), trial_dir)
-    _, model = load_model(config["env_id"], path)
-    returns = run_episodes(config["env_id"], model, int(config["episodes"]), int(config["eval_seed"])).returns
+    path = train_trial(env_id, config["algo"], int(config["seed"]), int(config["timesteps"]), trial_dir)
+    _, model = load_model(env_id, path)
+    if "solar_split" in config:
+        from orbit_env.agents.solar import fly_model
+
+        returns = fly_model(model, episodes, eval_seed, {"solar_split": config["solar_split"]}).returns
+    else:
+        returns = run_episodes(env_id, model, episodes, eval_seed).returns
     mean = float(returns.mean())
     never, dp = config.get("never_return"), config.get("dp_return")
     capture = None if never is None or dp is None or abs(dp - never) < 1e-9 else (mean - never) / (dp - never)
@@ -163,10 +178,28 @@ def run_trial(config: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def capture_references(env_id: str, episodes: int, eval_seed: int, include_dp: bool = True) -> dict[str, Any]:
-    """The mean returns the capture is measured between: never burning, and the DP (None without it)."""
-    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, run_episodes
+def capture_references(
+    env_id: str, episodes: int, eval_seed: int, include_dp: bool = True, *, workers: int | None = None
+) -> dict[str, Any]:
+    """The mean returns the capture is measured between: never burning, and the DP (None without it).
 
+    On the solar task, the rows ``never`` and ``dp`` of `orbit_env.agents.solar.evaluate_solar` on
+    the `SOLAR_EVAL_SPLIT` (``workers``: its processes solving the DPs; default: the cores).
+    """
+    from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, run_episodes
+    from orbit_env.envs import SOLAR_ENV_ID
+
+    if env_id == SOLAR_ENV_ID:
+        from orbit_env.agents.solar import evaluate_solar
+
+        flown = evaluate_solar(
+            episodes, eval_seed, solar_split=SOLAR_EVAL_SPLIT, include_dp=include_dp, workers=workers
+        ).flown
+        dp = flown.get("dp")
+        return {
+            "never_return": float(flown["never"].returns.mean()),
+            "dp_return": None if dp is None else float(dp.returns.mean()),
+        }
     never = run_episodes(env_id, hand_coded_policies(env_id)["never"], episodes, eval_seed).returns.mean()
     references: dict[str, Any] = {"never_return": float(never), "dp_return": None}
     if include_dp:
@@ -229,20 +262,30 @@ def sweep(
     eval_seed: int | None = None,
     include_dp: bool = True,
     cpus_per_trial: float = 1.0,
+    cpus: int | None = None,
+    workers: int | None = None,
     progress: Any = None,
 ) -> dict[str, Any]:
     """Run the trials on Ray Tune, write ``out_dir/results.json``, return its content (see the module).
+
+    ``cpus``: the CPUs of the local Ray (default: the cores; not with ``address``), so at most
+    ``cpus / cpus_per_trial`` trials run at once. ``workers``: the solar task's processes
+    solving the references' DPs (`capture_references`).
 
     Raises:
         ValueError: an unknown env or algorithm, one that does not fit the action space, counts below 1.
         ImportError: Ray is not installed (the ``cluster`` extra).
     """
-    from orbit_env.agents.evaluate import EVAL_SEED, check_env_id
+    import gymnasium
 
-    check_env_id(env_id)
-    from orbit_env.agents.evaluate import task_of
+    from orbit_env.agents.evaluate import EVAL_SEED
+    from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
 
-    kind = "continuous" if task_of(env_id).continuous else "discrete"
+    allowed = (*ENV_IDS, SOLAR_ENV_ID)
+    if env_id not in allowed:
+        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join(allowed)}")
+    base = gymnasium.make(env_id).unwrapped  # its action space (the solar task has no task_of)
+    kind = "discrete" if isinstance(base.action_space, gymnasium.spaces.Discrete) else "continuous"
     for algo in algos:
         if algo not in SWEEP_ALGOS:
             raise ValueError(f"unknown algorithm {algo!r}; allowed: {', '.join(SWEEP_ALGOS)}")
@@ -250,6 +293,8 @@ def sweep(
             raise ValueError(f"{algo} does not act in the {kind} action space of {env_id}")
     if seeds < 1 or timesteps < 1 or episodes < 1:
         raise ValueError("seeds, timesteps and episodes must be >= 1")
+    if cpus is not None and (address is not None or cpus < 1):
+        raise ValueError(f"cpus={cpus} is invalid; allowed: an integer >= 1, for a local Ray only (no address)")
     try:
         import ray
         from ray import tune
@@ -265,8 +310,9 @@ def sweep(
         references = json.loads(references_path.read_text())
     else:
         say("references: never" + (" and dp" if include_dp else ""))
-        references = capture_references(env_id, episodes, eval_seed, include_dp)
+        references = capture_references(env_id, episodes, eval_seed, include_dp, workers=workers)
         references_path.write_text(json.dumps(references) + "\n")
+    split = {"solar_split": SOLAR_EVAL_SPLIT} if env_id == SOLAR_ENV_ID else {}
     param_space = {
         "env_id": env_id,
         "algo": tune.grid_search(list(algos)),
@@ -275,10 +321,11 @@ def sweep(
         "episodes": int(episodes),
         "eval_seed": int(eval_seed),
         "out": str(out),
+        **split,
         **references,
     }
     start = time.perf_counter()
-    ray.init(address=address, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
+    ray.init(address=address, num_cpus=cpus, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
     try:
         trainable = tune.with_resources(_ray_trainable, {"cpu": cpus_per_trial})
         storage = out / "ray"
@@ -307,6 +354,7 @@ def sweep(
         "timesteps": int(timesteps),
         "episodes": int(episodes),
         "eval_seed": int(eval_seed),
+        **split,
         **references,
         "trials": trials,
         "table": table(trials),

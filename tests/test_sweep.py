@@ -68,6 +68,87 @@ def test_sweep_refuses_an_algorithm_that_does_not_fit(tmp_path):
         sweep("OrbitRaising-v0", ["ppo2"], 1, 10, tmp_path)
 
 
+def test_the_solar_sweep_takes_the_discrete_algorithms_only(tmp_path):
+    from orbit_env.agents.sweep import sweep
+
+    for algo in ("sac", "td3"):
+        with pytest.raises(
+            ValueError, match=f"{algo} does not act in the discrete action space of OrbitRaisingSolar-v0"
+        ):
+            sweep("OrbitRaisingSolar-v0", ["ppo", algo], 1, 10, tmp_path)
+    with pytest.raises(ValueError, match=r"unknown environment 'OrbitRaisingSun-v0'; allowed: .*OrbitRaisingSolar-v0"):
+        sweep("OrbitRaisingSun-v0", ["ppo"], 1, 10, tmp_path)
+
+
+def test_each_recipe_trains_its_environment():
+    from importlib import resources
+
+    from orbit_env.agents.sweep import RECIPES
+    from orbit_env.agents.train import load_config
+    from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
+
+    assert set(RECIPES) == {*ENV_IDS, SOLAR_ENV_ID}
+    for env_id, name in RECIPES.items():
+        assert load_config(resources.files("orbit_env.agents").joinpath(name))["env_id"] == env_id
+
+
+#: The thresholds the rules would be tuned to (their tuning flies 300 missions x 57 candidates:
+#: 45 s); the references and the learned rows do not depend on them.
+_TUNED = {"perigee_threshold": (400.0, 40.0), "life_threshold": (0.5, 40.0)}
+
+
+@pytest.mark.parametrize("algo", ["dqn", "ppo_recipe"])
+def test_a_solar_trial_is_scored_as_evaluate_scores_it(tmp_path, monkeypatch, algo):
+    """Trained on the env's default (train) split, flown on the evaluation's test missions, as a row of evaluate."""
+    import orbit_env.agents.solar as solar
+    from orbit_env.agents.evaluate import load_model
+    from orbit_env.agents.sweep import run_trial
+
+    monkeypatch.setattr(solar, "tune", lambda task: _TUNED)
+    drawn = []  # the missions the trial flies: (split, episodes, seed)
+    starts = solar.starts
+    monkeypatch.setattr(
+        solar,
+        "starts",
+        lambda task, n, seed: drawn.append((task.mission.solar_split, n, seed)) or starts(task, n, seed),
+    )
+    config = {"env_id": "OrbitRaisingSolar-v0", "algo": algo, "seed": 0, "timesteps": 300, "episodes": 6}
+    config |= {"eval_seed": 12345, "out": str(tmp_path), "solar_split": "test"}
+    trial = run_trial(config | {"never_return": 1400.0, "dp_return": 1800.0})
+    assert drawn[-1] == ("test", 6, 12345)
+    assert all(split == "train" for split, _, _ in drawn[:-1])  # the recipe's validation, if any: never the test
+    _, model = load_model("OrbitRaisingSolar-v0", trial["model"])
+    evaluation = solar.evaluate_solar(6, 12345, include_dp=False, learned={algo: model})
+    assert trial["mean_return"] == pytest.approx(evaluation.flown[algo].returns.mean(), abs=1e-9)
+    assert trial["capture"] == pytest.approx((trial["mean_return"] - 1400.0) / 400.0)
+
+
+def test_the_solar_references_are_the_evaluations_never_on_the_test_missions(monkeypatch):
+    import orbit_env.agents.solar as solar
+    from orbit_env.agents.sweep import capture_references
+    from orbit_env.envs.solar_task import SolarMission, SolarTask
+
+    monkeypatch.setattr(solar, "tune", lambda task: _TUNED)
+    references = capture_references("OrbitRaisingSolar-v0", 5, 12345, include_dp=False)
+    test = SolarTask(mission=SolarMission(solar_split="test"))
+    never = solar.fly(test, solar.starts(test, 5, 12345), solar.by_observation(test, solar.Never(test)))
+    assert references == {"never_return": pytest.approx(never.returns.mean(), abs=1e-9), "dp_return": None}
+
+
+@pytest.mark.slow
+def test_a_solar_sweep_says_its_split(tmp_path, capsys):
+    pytest.importorskip("ray", reason="needs orbit-env[cluster]")
+    from orbit_env.cli import main
+
+    argv = ["sweep", "--env", "OrbitRaisingSolar-v0", "--algos", "dqn", "--seeds", "1", "--timesteps", "160"]
+    argv += ["--episodes", "4", "--no-dp", "--cpus", "1", "--out", str(tmp_path / "sweep")]
+    assert main(argv) == 0
+    assert "OrbitRaisingSolar-v0 (test split)" in capsys.readouterr().out
+    results = json.loads((tmp_path / "sweep" / "results.json").read_text())
+    assert results["solar_split"] == "test" and results["cores"] == 1
+    assert [(t["algo"], t["seed"]) for t in results["trials"]] == [("dqn", 0)]
+
+
 def test_the_shipped_baseline_tables_are_complete():
     from importlib import resources
 

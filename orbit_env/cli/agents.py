@@ -169,12 +169,15 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             address=args.address,
             episodes=args.episodes,
             include_dp=not args.no_dp,
+            cpus=args.cpus,
+            workers=args.workers,
             progress=lambda text: print(f"  {text} ...", file=sys.stderr),
         )
     except SweepInterrupted as stopped:
         print(f"orbit-env sweep: {stopped}", file=sys.stderr)
         return 1
-    print(format_table(args.env, result["table"], args.timesteps))
+    split = result.get("solar_split")
+    print(format_table(args.env if split is None else f"{args.env} ({split} split)", result["table"], args.timesteps))
     print(
         f"{len(result['trials'])} trials on {result['cores']} cores in {result['sweep_wall_s']:.0f} s; "
         f"{args.out}/results.json"
@@ -268,7 +271,16 @@ def add_parsers(sub: Any) -> None:
         type=positive_int,
         default=EVAL_EPISODES,
         metavar="N",
-        help=f"evaluation episodes per trial (default {EVAL_EPISODES})",
+        help=f"evaluation episodes per trial (default {EVAL_EPISODES}; OrbitRaisingSolar-v0: test-split missions)",
     )
     sw.add_argument("--no-dp", action="store_true", help="no capture (skips the DP's solve)")
+    sw.add_argument(
+        "--cpus", type=positive_int, metavar="N", help="CPUs of the local Ray, one a trial (default: the cores)"
+    )
+    sw.add_argument(
+        "--workers",
+        type=positive_int,
+        metavar="N",
+        help="OrbitRaisingSolar-v0: processes solving the references' DPs (default: cores)",
+    )
     sw.set_defaults(func=_cmd_sweep)
