@@ -12,8 +12,9 @@ import pytest
 
 from orbit_env import cache
 from orbit_env.decay import daily_air
-from orbit_env.decay.chunked import RATIO_GRID_M, RATIO_NODES, SolarDecayModel, air_table
+from orbit_env.decay.chunked import SolarDecayModel, air_table
 from orbit_env.decay.daily_air import DailyAirTable
+from orbit_env.decay.density_multiplier import RATIO_GRID_M, RATIO_NODES
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import load_record
 from orbit_env.physics.atmosphere.msis import (

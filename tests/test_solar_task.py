@@ -22,8 +22,8 @@ from orbit_env.agents.solar_dp import SolarDP
 from orbit_env.analysis.air.msis import MsisAir
 from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.decay.chunked import RATIO_GRID_M
 from orbit_env.decay.curves import NU_REF
+from orbit_env.decay.density_multiplier import RATIO_GRID_M
 from orbit_env.decay.drag_clock import drag_days_at
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import shipped_record

@@ -22,9 +22,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.decay.chunked import RATIO_NODES
 from orbit_env.decay.curves import NU_REF, UniversalCurves, days_from_weighted_s
 from orbit_env.decay.density_multiplier import (
+    FINE_RATIO_GRID_M,
+    RATIO_NODES,
     SPREAD_MAX_SPAN_M,
     SPREAD_QUADRATURE_POINTS,
     corotation_factor,
@@ -37,8 +38,6 @@ from orbit_env.decay.density_multiplier import (
 
 FloatArray = NDArray[np.float64]
 
-#: Heights [m] of the ratio (uniform: the rows' tables are read by index).
-RATIO_HEIGHTS_M = np.arange(100e3, 1200e3 + 1.0, 25e3)
 
 #: Points along each decay (equal steps of the curves' tau) where the multiplier is taken.
 PATH_NODES = 48
@@ -49,21 +48,21 @@ WIDE_PATH_NODES = 32
 
 
 def inclination_log_ratio(scenario: Scenario, reference_deg: float, inclination_deg: FloatArray) -> FloatArray:
-    """ln(the air's density at each inclination / at ``reference_deg``) on ``RATIO_HEIGHTS_M``, shape (n, heights).
+    """ln(the air's density at each inclination / at ``reference_deg``) on ``FINE_RATIO_GRID_M``, shape (n, heights).
 
     Zero for an air that does not depend on the inclination. NRLMSIS is averaged over the
     year at every ``ANCHOR_STEP_DEG`` spanning the inclinations, in one call, and its
     logarithm interpolated in inclination by a cubic spline.
     """
     inclination = np.asarray(inclination_deg, dtype=np.float64)
-    zero = np.zeros((inclination.size, RATIO_HEIGHTS_M.size))
+    zero = np.zeros((inclination.size, FINE_RATIO_GRID_M.size))
     if not scenario.air.depends_on_inclination:
         return zero
     anchors = inclination_anchors(inclination, reference_deg)
     if anchors.size < 2:
         return zero
     # The chunks' nodes (6 x 6): against 12 x 6, ln ratio within 2e-4 at 150-1200 km.
-    rho = scenario.air.mean_density_over_inclinations_kg_m3(RATIO_HEIGHTS_M, anchors, **RATIO_NODES)
+    rho = scenario.air.mean_density_over_inclinations_kg_m3(FINE_RATIO_GRID_M, anchors, **RATIO_NODES)
     return np.asarray(inclination_basis(anchors, inclination, reference_deg) @ np.log(rho), dtype=np.float64)
 
 
@@ -132,7 +131,7 @@ def _spread_days(
     if wide:
         ratio = _life_rate_ratio(curves, log_ratio, inclination_deg, hp, ha, weighted)
     else:
-        log_value, log_slope = interpolate_rows_with_slope(log_ratio, RATIO_HEIGHTS_M, hp)
+        log_value, log_slope = interpolate_rows_with_slope(log_ratio, FINE_RATIO_GRID_M, hp)
         ratio = np.exp(log_value)
         if scenario.air.depends_on_inclination:
             from orbit_env.decay.density_multiplier import log_density_slope_per_m
@@ -169,7 +168,7 @@ def _life_rate_ratio(
     ratio = life_rate_ratio(
         curves,
         log_ratio,
-        RATIO_HEIGHTS_M,
+        FINE_RATIO_GRID_M,
         perigee_m,
         apogee_m,
         quadrature_points=SPREAD_QUADRATURE_POINTS,

@@ -36,6 +36,8 @@ from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.daily_air import DailyAirTable, daily_air_table
 from orbit_env.decay.density_multiplier import (
+    RATIO_GRID_M,
+    RATIO_NODES,
     SPREAD_MAX_SPAN_M,
     SPREAD_QUADRATURE_POINTS,
     corotation_factor,
@@ -91,10 +93,6 @@ NEAR_CIRCULAR_AP_BINS = (3.0, 12.0, 48.0, 192.0)
 #: Those wider orbits' ratio of the life's rates is recomputed when the perigee has moved this far [m] (or the bin
 #: changed), and held in between as a factor on the ratio over the orbit.
 SPREAD_REFRESH_M = 5e3
-#: Heights at which the exact/bin density ratio is tabulated [m].
-RATIO_GRID_M = np.arange(100e3, 1200e3 + 1.0, 50e3)
-#: Latitude and local-time nodes of the ratio (both profiles sampled alike).
-RATIO_NODES = {"latitude_nodes": 6, "local_time_nodes": 6}
 
 #: Days [d] whose air is computed together when a chunk meets a day the air table does not hold yet
 #: (`orbit_env.decay.daily_air`): one NRLMSIS call of half a year instead of one per chunk.

@@ -3,7 +3,7 @@
 A decay under changing activity (`orbit_env.decay.chunked`) needs, for every day it
 crosses, NRLMSIS averaged over the orbit's latitudes and local times at that day's
 indices (F10.7, its 81-day mean, Ap, the day of the year), on the heights of
-`orbit_env.decay.chunked.RATIO_GRID_M`. Those rows depend on the day's indices, the
+`orbit_env.decay.density_multiplier.RATIO_GRID_M`. Those rows depend on the day's indices, the
 inclination, the Sun-synchronous node (if any) and the NRLMSIS version, never on the
 satellite: a `DailyAirTable` holds them per (inclination, node, version), keyed by the
 indices as the decay rounds them (0.1 sfu, 0.1 Ap, the day of the year to 2 days), so

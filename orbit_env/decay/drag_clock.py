@@ -7,7 +7,7 @@ calendar. A `DragClock` holds, for one inclination, the curves of a reference NR
 profile and the cumulative C_h(d) of each day's multiplier s_h(d): the day's
 orbit-averaged NRLMSIS density (the shipped record's F10.7, 81-day mean, Ap and day of
 the year; `orbit_env.decay.daily_air`) over the reference profile's, at each height h
-of `orbit_env.decay.chunked.RATIO_GRID_M`. A decay over days [d0, d1) at perigee h then
+of `orbit_env.decay.density_multiplier.RATIO_GRID_M`. A decay over days [d0, d1) at perigee h then
 drops W by g c (C_h(d1) - C_h(d0)) days: two lookups, whatever the span.
 
 The multiplier is taken at the perigee, where a near-circular orbit meets its drag and an
@@ -28,8 +28,9 @@ from functools import cached_property, lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.decay.chunked import RATIO_GRID_M, SolarDecayModel, bin_indices, cached_curves
+from orbit_env.decay.chunked import SolarDecayModel, bin_indices, cached_curves
 from orbit_env.decay.curves import UniversalCurves
+from orbit_env.decay.density_multiplier import RATIO_GRID_M
 from orbit_env.decay.solar import F107A_WINDOW_DAYS
 from orbit_env.decay.solar_record import RecordActivity, shipped_record
 from orbit_env.physics.atmosphere.msis import DEFAULT_MSIS_VERSION
