@@ -18,6 +18,7 @@ import numpy as np
 
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.air.msis import MSIS_VERSION_CHOICES
+from orbit_env.analysis.drag_source import drag_sigma
 from orbit_env.analysis.lifetime import (
     METHODS,
     PAPER_DRAG_COEFFICIENT,
@@ -115,7 +116,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     uncertain_batch.check_options(args)
     orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
-    satellite, drag_source, drag_report = orbit_inputs.satellite_from_args(args, orbit, scenario)
+    drag = orbit_inputs.satellite_from_args(args, orbit, scenario)
+    satellite = drag.satellite
     if args.batch:
         return _lifetime_batch(args, satellite, scenario)
     if args.out:
@@ -139,8 +141,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         height_reference=orbit.reference,
         inclination_deg=args.inclination,
         drag_parameter_m2_kg=satellite.drag_parameter_m2_kg,
-        drag_parameter_source=drag_source,
-        **drag_report,
+        drag_parameter_source=drag.source,
+        **drag.report,
     )
     if orbit.elements is not None:
         summary.update(orbit_inputs.elements_report(orbit.elements, result))
@@ -162,8 +164,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         )
     band = None
     if args.uncertainty:
-        sigma = orbit_inputs.drag_sigma(drag_source, drag_report)
-        band = orbit_inputs.uncertainty(args, orbit, scenario, satellite, result, summary, sigma)
+        band = orbit_inputs.uncertainty(args, orbit, scenario, satellite, result, summary, drag_sigma(drag))
     if args.trajectory:
         write_csv(args.trajectory, orbit_inputs.history_rows(result.history, offset, result.epoch_days))
     if args.plot:
@@ -177,7 +178,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     check_finite(summary, "the result")
     for line in orbit_inputs.orbit_lines(orbit, args.inclination):
         print(line)
-    print(orbit_inputs.satellite_line(satellite, drag_source, drag_report))
+    print(orbit_inputs.satellite_line(drag))
     print(f"atmosphere         {_atmosphere(args, scenario)}")
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")

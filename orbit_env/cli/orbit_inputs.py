@@ -20,24 +20,21 @@ from typing import TYPE_CHECKING, Any
 
 from orbit_env.analysis.air import DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.drag_calibration import SOURCE_BSTAR_CALIBRATED
+from orbit_env.analysis.drag_source import (
+    DRAG_FROM_CHOICES,
+    SOURCE_BSTAR,
+    DragSource,
+    SatelliteInputs,
+    drag_source,
+    element_set_orbits,
+)
 from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
-from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
+from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
-from orbit_env.cli.common import given, number
+from orbit_env.cli.common import number
 
 if TYPE_CHECKING:
     from orbit_env.analysis.catalogue_io import BatchOrbits
-
-#: What ``drag_parameter_source`` says in JSON.
-SOURCE_BSTAR = "bstar"
-SOURCE_SATELLITE = "satellite"
-SOURCE_SHAPE = "shape"
-SOURCE_DEFAULT = "default"
-_SATELLITE_FLAGS = ("mass", "area", "mass_per_area", "cx", "shape")
-#: ``--drag-from``: what of an element set gives the drag parameter.
-DRAG_FROM_SOURCES = {"bstar": "bstar_calibrated", "ndot": "ndot_calibrated"}
-DRAG_FROM_DEFAULT = "bstar"
-DRAG_FROM_CHOICES = (*DRAG_FROM_SOURCES, "bstar-raw")
 
 
 @dataclass(frozen=True)
@@ -165,122 +162,31 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
     return OrbitInput(perigee, apogee, reference)
 
 
-def satellite_from_args(
-    args: argparse.Namespace, orbit: OrbitInput, scenario: Any
-) -> tuple[Satellite, str, dict[str, Any]]:
-    """The satellite, where its drag parameter came from, and what to report about it.
-
-    The satellite's flags win; else a TLE's B*; else the paper's sphere. ``--shape``
-    computes the free-molecular C_D at the start (``--cx`` still overrides it).
-    """
-    cx = PAPER_DRAG_COEFFICIENT if args.cx is None else args.cx
-    shape = getattr(args, "shape", None)
-    report: dict[str, Any] = {}
-    if shape is None and getattr(args, "diameter_m", None) is not None:
-        raise ValueError("--diameter-m goes with --shape sphere")
-    if shape is not None:
-        if args.diameter_m is None:
-            raise ValueError("--shape sphere needs --diameter-m")
-        if args.mass is None:
-            raise ValueError("--shape needs --mass (the drag parameter is C_D A / m)")
-        if args.area is not None or args.mass_per_area is not None:
-            raise ValueError("--shape sets the area; do not give --area or --mass-per-area")
-        from orbit_env.analysis.shapes import sphere
-
-        body = sphere(args.diameter_m)
-        if args.cx is None and orbit.perigee_km is not None and orbit.apogee_km is not None:
-            cx, conditions = _shape_drag_coefficient(body, orbit, scenario, args)
-            report.update(conditions)
-        return make_satellite(cx, args.mass, body.reference_area_m2), SOURCE_SHAPE, report
-    satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
-    elements = orbit.elements
-    history = getattr(args, "tle_history", None)
-    if not satellite_given and history is not None:
-        from orbit_env.analysis.drag_calibration import SOURCE_HISTORY_FIT, fit_history
-
-        if getattr(args, "drag_from", None) is not None:
-            raise ValueError("--drag-from chooses what one element set gives; a history's drag is fitted to its decay")
-        fit = fit_history(history, scenario.in_sphere_heights(orbit.reference, args.inclination))
-        report["drag_fit"] = fit.report()
-        return Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, report
-    if not satellite_given and elements is not None and elements.bstar_per_earth_radius is not None:
-        c, source = _drag_from_elements(args, elements, scenario.in_sphere_heights(orbit.reference, args.inclination))
-        report["bstar_per_earth_radius"] = elements.bstar_per_earth_radius
-        report["ndot_rev_day2"] = elements.ndot_rev_day2
-        if isinstance(c, tuple):  # calibrated: (c, DragCalibration)
-            c, calibration = c
-            report.update(calibration.report())
-        # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
-        return Satellite(1.0, 1.0, c), source, report
-    satellite = make_satellite(cx, args.mass, args.area, args.mass_per_area)
-    return satellite, SOURCE_SATELLITE if satellite_given else SOURCE_DEFAULT, report
-
-
-def _drag_from_elements(args: argparse.Namespace, elements: Any, scenario: Any) -> tuple[Any, str]:
-    """The drag parameter an element set carries (``--drag-from``), and its source's name.
-
-    Raises:
-        ValueError: the set carries no decay (B* or ndot not above zero): give the satellite.
-    """
-    from orbit_env.analysis.drag_calibration import SOURCE_NDOT_CALIBRATED, calibrate
-
-    how = getattr(args, "drag_from", None) or DRAG_FROM_DEFAULT
-    if how == "bstar-raw":
-        c = elements.drag_parameter_m2_kg
-        if c is None:
-            raise ValueError(
-                f"the element set's B* = {elements.bstar_per_earth_radius:g} /ER gives no drag parameter "
-                "(it must be above 0); give the satellite: --mass and --area (or --shape)"
-            )
-        return c, SOURCE_BSTAR
-    source = DRAG_FROM_SOURCES[how]
-    calibration = calibrate(elements, scenario, source=source)
-    if calibration is None:
-        value = (
-            f"ndot = {elements.ndot_rev_day2:g} rev/day^2"
-            if source == SOURCE_NDOT_CALIBRATED
-            else f"B* = {elements.bstar_per_earth_radius:g} /ER"
-        )
-        raise ValueError(
-            f"the element set's {value} gives no drag parameter (it must be above 0); give the satellite: "
-            "--mass and --area (or --shape)"
-        )
-    return (calibration.drag_parameter_m2_kg, calibration), calibration.source
-
-
-def _shape_drag_coefficient(body: Any, orbit: OrbitInput, scenario: Any, args: argparse.Namespace) -> Any:
-    """The shape's C_D at the start orbit's mean height, in the scenario's gas (NRLMSIS)."""
-    from orbit_env.analysis.shapes import drag_at_start
-
-    hp, ha = orbit.sphere_heights_km
-    # An air without a temperature of its own gives NRLMSIS's gas at moderate activity (Air.gas_activity).
-    activity, start = scenario.air.gas_activity()
-    indices = activity.indices(start) if start is not None else _constant(activity)
-    date = None if start is None else str(_datetime(start))
-    result = drag_at_start(
-        body,
-        0.5 * (hp + ha) * 1e3,
-        args.inclination,
-        tuple(float(x) for x in indices),
-        date,
-        ascending_node_local_time_h=getattr(args, "node_local_time", None),
-        rotating_atmosphere=True,
+def satellite_inputs(args: argparse.Namespace) -> SatelliteInputs:
+    """What the command line says about the satellite."""
+    return SatelliteInputs(
+        mass_kg=getattr(args, "mass", None),
+        area_m2=getattr(args, "area", None),
+        mass_per_area_kg_m2=getattr(args, "mass_per_area", None),
+        drag_coefficient=getattr(args, "cx", None),
+        shape=getattr(args, "shape", None),
+        diameter_m=getattr(args, "diameter_m", None),
+        drag_from=getattr(args, "drag_from", None),
     )
-    return result.drag_coefficient, {
-        "drag_coefficient": result.drag_coefficient,
-        "speed_ratio": result.speed_ratio,
-        "gas_temperature_k": result.temperature_k,
-    }
 
 
-def _constant(activity: Any) -> tuple[float, float, float]:
-    return float(activity.f107_sfu), float(activity.f107a_sfu), float(activity.ap)
-
-
-def _datetime(days: float) -> Any:
-    import numpy as np
-
-    return np.datetime64(round(days * 86400.0), "s")
+def satellite_from_args(args: argparse.Namespace, orbit: OrbitInput, scenario: Any) -> DragSource:
+    """The satellite and where its drag parameter came from (`orbit_env.analysis.drag_source.drag_source`)."""
+    known = orbit.perigee_km is not None and orbit.apogee_km is not None
+    return drag_source(
+        satellite_inputs(args),
+        scenario.in_sphere_heights(orbit.reference, args.inclination),
+        args.inclination,
+        sphere_heights_km=orbit.sphere_heights_km if known else None,
+        elements=orbit.elements,
+        history=getattr(args, "tle_history", None),
+        ascending_node_local_time_h=getattr(args, "node_local_time", None),
+    )
 
 
 def elements_report(elements: Any, result: Any = None) -> dict[str, Any]:
@@ -329,8 +235,9 @@ def orbit_lines(orbit: OrbitInput, inclination_deg: float) -> list[str]:
     return lines
 
 
-def satellite_line(satellite: Satellite, source: str, report: dict[str, Any]) -> str:
+def satellite_line(drag: DragSource) -> str:
     """The text output's line about the satellite."""
+    satellite, source, report = drag.satellite, drag.source, drag.report
     c = satellite.drag_parameter_m2_kg
     if source == SOURCE_BSTAR:
         return (
@@ -388,7 +295,6 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
     import numpy as np
 
     from orbit_env.analysis.catalogue_io import BatchOrbits, read_batch
-    from orbit_env.analysis.drag_calibration import calibrate, fit_history
     from orbit_env.analysis.elements import looks_like_tle, read_tle
 
     if looks_like_tle(args.batch) and not getattr(args, "height_reference_given", False):
@@ -402,45 +308,13 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
         return BatchOrbits(rows, hp + offset_m, ha + offset_m, c, inc, status, none, none)
     if args.height_reference != "equatorial":
         raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
-    histories: dict[str, list[Any]] = {}
-    for s in read_tle(args.batch):
-        histories.setdefault(s.catalogue_number, []).append(s)
-    objects = [sorted(sets, key=lambda s: s.epoch_days) for sets in histories.values()]
-    latest = [sets[-1] for sets in objects]
-    satellite_given = any(given(args, name) for name in _SATELLITE_FLAGS if hasattr(args, name))
-    rows = [{"name": s.name} for s in latest]
-    hp = np.array([s.flown_perigee_km for s in latest]) * 1e3 + offset_m
-    ha = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
-    inc = np.array([s.inclination_deg for s in latest])
-    c = np.full(len(latest), satellite.drag_parameter_m2_kg)
-    sigma = np.full(len(latest), np.nan)
-    status = ["ok"] * len(latest)
-    air = scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0))
-    for i, (s, sets) in enumerate(zip(latest, objects, strict=True)):
-        if satellite_given:
-            continue
-        try:
-            if len(sets) > 1:
-                fit = fit_history(sets, air)
-                c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
-            else:
-                calibration = calibrate(s, air)
-                if calibration is None:
-                    status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
-                else:
-                    c[i], sigma[i] = calibration.drag_parameter_m2_kg, ONE_SET_DRAG_SIGMA
-        except ValueError as error:
-            status[i] = f"line {s.line}: {error}"
-    from orbit_env.decay.curves import UniversalCurves
-
-    for i in range(len(latest)):
-        if status[i] == "ok":
-            try:
-                UniversalCurves.check_domain(hp[i], ha[i])
-            except ValueError as error:
-                status[i] = f"line {latest[i].line}: {error}"
-    epochs = np.array([s.epoch_days for s in latest], dtype=np.float64)
-    return BatchOrbits(rows, hp, ha, c, inc, status, sigma, epochs)
+    return element_set_orbits(
+        read_tle(args.batch),
+        satellite,
+        scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0)),
+        satellite_given=satellite_inputs(args).given,
+        offset_m=offset_m,
+    )
 
 
 def records_in_reference(records: list[dict[str, Any]], reference: str) -> list[dict[str, Any]]:
@@ -500,20 +374,6 @@ def uncertainty(
     summary.update(spread_report(spread, epoch, args.rule))
     low, high = summary["days_percentiles"]["5"], summary["days_percentiles"]["95"]
     return None if low is None or high is None else (low, high)
-
-
-def drag_sigma_of(source: str) -> float | None:
-    """The drag parameter's log-normal sigma by its source (None: the default, a known satellite's C_D)."""
-    from orbit_env.analysis.drag_calibration import SOURCE_NDOT_CALIBRATED
-
-    return ONE_SET_DRAG_SIGMA if source in (SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, SOURCE_BSTAR) else None
-
-
-def drag_sigma(source: str, report: dict[str, Any]) -> float | None:
-    """The drag parameter's log-normal sigma: a history's from its fit, one set's measured, else the default."""
-    if "drag_fit" in report:
-        return float(report["drag_fit"]["sigma_ln"])
-    return drag_sigma_of(source)
 
 
 def uncertainty_lines(summary: dict[str, Any]) -> list[str]:

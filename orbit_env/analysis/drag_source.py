@@ -1,0 +1,273 @@
+"""Where a satellite's drag parameter comes from: its mass and area, its shape, one element set, or a history.
+
+The analyst's satellite wins: a mass and an area (or a load, a drag coefficient), or a
+mass and a shape whose free-molecular C_D is computed at the start orbit. Without one,
+an element set's decay gives the drag parameter: a history of sets (one object's) by
+the fit of their mean motion's decay (`orbit_env.analysis.drag_calibration.fit_history`),
+one set by its B* (or ndot) calibrated to the chosen air at its epoch
+(`orbit_env.analysis.drag_calibration.calibrate`), or B* read raw against SGP4's own
+density (to compare). Without either, the paper's sphere. `drag_sigma` says how uncertain
+each source leaves the drag parameter, for the uncertainty run.
+
+The command line (`orbit_env.cli.orbit_inputs`) only reads the flags into
+`SatelliteInputs` and prints what comes back.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from orbit_env.analysis.catalogue_io import BatchOrbits
+from orbit_env.analysis.drag_calibration import (
+    SOURCE_BSTAR_CALIBRATED,
+    SOURCE_HISTORY_FIT,
+    SOURCE_NDOT_CALIBRATED,
+    calibrate,
+    fit_history,
+)
+from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
+from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
+
+#: What ``drag_parameter_source`` says in JSON.
+SOURCE_BSTAR = "bstar"
+SOURCE_SATELLITE = "satellite"
+SOURCE_SHAPE = "shape"
+SOURCE_DEFAULT = "default"
+#: ``--drag-from``: what of an element set gives the drag parameter.
+DRAG_FROM_SOURCES = {"bstar": SOURCE_BSTAR_CALIBRATED, "ndot": SOURCE_NDOT_CALIBRATED}
+DRAG_FROM_DEFAULT = "bstar"
+DRAG_FROM_CHOICES = (*DRAG_FROM_SOURCES, "bstar-raw")
+
+
+@dataclass(frozen=True)
+class SatelliteInputs:
+    """What the analyst said about the satellite (None: not said).
+
+    Attributes:
+        mass_kg: Mass.
+        area_m2: Reference area.
+        mass_per_area_kg_m2: Transverse load G/F (instead of mass and area).
+        drag_coefficient: c_x.
+        shape: ``sphere``: the free-molecular C_D of this shape at the start (needs the mass).
+        diameter_m: The sphere's diameter.
+        drag_from: What of one element set gives the drag parameter (`DRAG_FROM_CHOICES`).
+    """
+
+    mass_kg: float | None = None
+    area_m2: float | None = None
+    mass_per_area_kg_m2: float | None = None
+    drag_coefficient: float | None = None
+    shape: str | None = None
+    diameter_m: float | None = None
+    drag_from: str | None = None
+
+    @property
+    def given(self) -> bool:
+        """Whether the satellite itself was described (it then wins over any element set)."""
+        described = (self.mass_kg, self.area_m2, self.mass_per_area_kg_m2, self.drag_coefficient, self.shape)
+        return any(value is not None for value in described)
+
+
+@dataclass(frozen=True)
+class DragSource:
+    """The satellite the decay flies, where its drag parameter came from, and what to report about it.
+
+    Attributes:
+        satellite: The satellite (from an element set: c_x 1 on c m^2 per kg).
+        source: ``drag_parameter_source`` (`SOURCE_SATELLITE`, `SOURCE_SHAPE`, `SOURCE_DEFAULT`,
+            `SOURCE_BSTAR`, or the calibrations' and the history fit's names).
+        report: What JSON says about it (the calibration, the fit, the shape's gas).
+    """
+
+    satellite: Satellite
+    source: str
+    report: dict[str, Any] = field(default_factory=dict)
+
+
+def drag_source(
+    inputs: SatelliteInputs,
+    scenario: Any,
+    inclination_deg: float,
+    *,
+    sphere_heights_km: tuple[float, float] | None = None,
+    elements: Any = None,
+    history: list[Any] | None = None,
+    ascending_node_local_time_h: float | None = None,
+) -> DragSource:
+    """The satellite and its drag parameter's source (see the module docstring).
+
+    Args:
+        inputs: What the analyst said about the satellite.
+        scenario: The scenario in the 6371 km sphere's heights (`Scenario.in_sphere_heights`).
+        inclination_deg: The orbit's inclination.
+        sphere_heights_km: Start perigee and apogee above the sphere (for a shape's C_D).
+        elements: The element set the orbit came from (its latest, for a history).
+        history: Several element sets of one object, oldest first.
+        ascending_node_local_time_h: For a shape's gas in a Sun-synchronous orbit.
+
+    Raises:
+        ValueError: inputs that do not go together, or an element set without decay.
+    """
+    if inputs.shape is None and inputs.diameter_m is not None:
+        raise ValueError("--diameter-m goes with --shape sphere")
+    cx = PAPER_DRAG_COEFFICIENT if inputs.drag_coefficient is None else inputs.drag_coefficient
+    if inputs.shape is not None:
+        if inputs.diameter_m is None:
+            raise ValueError("--shape sphere needs --diameter-m")
+        if inputs.mass_kg is None:
+            raise ValueError("--shape needs --mass (the drag parameter is C_D A / m)")
+        if inputs.area_m2 is not None or inputs.mass_per_area_kg_m2 is not None:
+            raise ValueError("--shape sets the area; do not give --area or --mass-per-area")
+        from orbit_env.analysis.shapes import sphere
+
+        body = sphere(inputs.diameter_m)
+        report: dict[str, Any] = {}
+        if inputs.drag_coefficient is None and sphere_heights_km is not None:
+            cx, report = shape_drag_coefficient(
+                body, sphere_heights_km, inclination_deg, scenario, ascending_node_local_time_h
+            )
+        return DragSource(make_satellite(cx, inputs.mass_kg, body.reference_area_m2), SOURCE_SHAPE, report)
+    if not inputs.given and history is not None:
+        if inputs.drag_from is not None:
+            raise ValueError("--drag-from chooses what one element set gives; a history's drag is fitted to its decay")
+        fit = fit_history(history, scenario)
+        return DragSource(Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, {"drag_fit": fit.report()})
+    if not inputs.given and elements is not None and elements.bstar_per_earth_radius is not None:
+        c, source, calibration_report = drag_from_elements(elements, scenario, inputs.drag_from or DRAG_FROM_DEFAULT)
+        report = {"bstar_per_earth_radius": elements.bstar_per_earth_radius, "ndot_rev_day2": elements.ndot_rev_day2}
+        report.update(calibration_report)
+        # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
+        return DragSource(Satellite(1.0, 1.0, c), source, report)
+    satellite = make_satellite(cx, inputs.mass_kg, inputs.area_m2, inputs.mass_per_area_kg_m2)
+    return DragSource(satellite, SOURCE_SATELLITE if inputs.given else SOURCE_DEFAULT)
+
+
+def drag_from_elements(elements: Any, scenario: Any, how: str = DRAG_FROM_DEFAULT) -> tuple[float, str, dict[str, Any]]:
+    """The drag parameter one element set carries: (c [m^2/kg], its source's name, the calibration's report).
+
+    ``how``: one of `DRAG_FROM_CHOICES` (``bstar``, ``ndot``: calibrated to ``scenario``'s air at
+    the set's epoch; ``bstar-raw``: 2 B*/rho0 against SGP4's own density).
+
+    Raises:
+        ValueError: the set carries no decay (B* or ndot not above zero): give the satellite.
+    """
+    if how == "bstar-raw":
+        c = elements.drag_parameter_m2_kg
+        if c is None:
+            raise ValueError(
+                f"the element set's B* = {elements.bstar_per_earth_radius:g} /ER gives no drag parameter "
+                "(it must be above 0); give the satellite: --mass and --area (or --shape)"
+            )
+        return c, SOURCE_BSTAR, {}
+    source = DRAG_FROM_SOURCES[how]
+    calibration = calibrate(elements, scenario, source=source)
+    if calibration is None:
+        value = (
+            f"ndot = {elements.ndot_rev_day2:g} rev/day^2"
+            if source == SOURCE_NDOT_CALIBRATED
+            else f"B* = {elements.bstar_per_earth_radius:g} /ER"
+        )
+        raise ValueError(
+            f"the element set's {value} gives no drag parameter (it must be above 0); give the satellite: "
+            "--mass and --area (or --shape)"
+        )
+    return calibration.drag_parameter_m2_kg, calibration.source, calibration.report()
+
+
+def shape_drag_coefficient(
+    body: Any,
+    sphere_heights_km: tuple[float, float],
+    inclination_deg: float,
+    scenario: Any,
+    ascending_node_local_time_h: float | None = None,
+) -> tuple[float, dict[str, Any]]:
+    """The shape's C_D at the start orbit's mean height in the scenario's gas (NRLMSIS), and what to report."""
+    from orbit_env.analysis.shapes import drag_at_start
+
+    hp, ha = sphere_heights_km
+    # An air without a temperature of its own gives NRLMSIS's gas at moderate activity (Air.gas_activity).
+    activity, start = scenario.air.gas_activity()
+    if start is not None:
+        indices = activity.indices(start)
+    else:
+        indices = (activity.f107_sfu, activity.f107a_sfu, activity.ap)
+    date = None if start is None else str(np.datetime64(round(start * 86400.0), "s"))
+    result = drag_at_start(
+        body,
+        0.5 * (hp + ha) * 1e3,
+        inclination_deg,
+        tuple(float(x) for x in indices),
+        date,
+        ascending_node_local_time_h=ascending_node_local_time_h,
+        rotating_atmosphere=True,
+    )
+    return result.drag_coefficient, {
+        "drag_coefficient": result.drag_coefficient,
+        "speed_ratio": result.speed_ratio,
+        "gas_temperature_k": result.temperature_k,
+    }
+
+
+def drag_sigma_of(source: str) -> float | None:
+    """The drag parameter's log-normal sigma by its source (None: the default, a known satellite's C_D)."""
+    return ONE_SET_DRAG_SIGMA if source in (SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, SOURCE_BSTAR) else None
+
+
+def drag_sigma(source: DragSource) -> float | None:
+    """The drag parameter's log-normal sigma: a history's from its fit, one set's measured, else the default."""
+    if "drag_fit" in source.report:
+        return float(source.report["drag_fit"]["sigma_ln"])
+    return drag_sigma_of(source.source)
+
+
+def element_set_orbits(
+    sets: list[Any], satellite: Satellite, scenario: Any, *, satellite_given: bool, offset_m: float = 0.0
+) -> BatchOrbits:
+    """A batch of element sets as orbits in the sphere's heights [m] (``offset_m`` added), one row an object.
+
+    Each object's sets are its history: its row starts from its latest set, the heights of
+    the orbit flown, its inclination and, unless ``satellite`` is given, the drag fitted to
+    the decay between its sets; an object with one set has its B* calibrated to
+    ``scenario``'s air (in the sphere's heights). With ``satellite_given`` every row flies ``satellite``.
+    A row that cannot be decayed says why in its status, naming the set's line.
+    """
+    from orbit_env.decay.curves import UniversalCurves
+
+    histories: dict[str, list[Any]] = {}
+    for s in sets:
+        histories.setdefault(s.catalogue_number, []).append(s)
+    objects = [sorted(history, key=lambda s: s.epoch_days) for history in histories.values()]
+    latest = [history[-1] for history in objects]
+    rows = [{"name": s.name} for s in latest]
+    hp = np.array([s.flown_perigee_km for s in latest]) * 1e3 + offset_m
+    ha = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
+    inc = np.array([s.inclination_deg for s in latest])
+    c = np.full(len(latest), satellite.drag_parameter_m2_kg)
+    sigma = np.full(len(latest), np.nan)
+    status = ["ok"] * len(latest)
+    for i, (s, history) in enumerate(zip(latest, objects, strict=True)):
+        if satellite_given:
+            continue
+        try:
+            if len(history) > 1:
+                fit = fit_history(history, scenario)
+                c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
+            else:
+                calibration = calibrate(s, scenario)
+                if calibration is None:
+                    status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
+                else:
+                    c[i], sigma[i] = calibration.drag_parameter_m2_kg, ONE_SET_DRAG_SIGMA
+        except ValueError as error:
+            status[i] = f"line {s.line}: {error}"
+    for i in range(len(latest)):
+        if status[i] == "ok":
+            try:
+                UniversalCurves.check_domain(hp[i], ha[i])
+            except ValueError as error:
+                status[i] = f"line {latest[i].line}: {error}"
+    epochs = np.array([s.epoch_days for s in latest], dtype=np.float64)
+    return BatchOrbits(rows, hp, ha, c, inc, status, sigma, epochs)
