@@ -21,14 +21,22 @@ Every plan is scored in ``gymnasium.make_vec`` of the environment (the task mode
 shortcut), all starts and candidates at once; the plans that beat the DP are replayed
 in ``gymnasium.make``, one environment each, and the replayed returns are the ones
 reported. The gap of a start is max(0, best plan - DP policy) in days of return.
+
+On ``OrbitRaisingSolar-v0`` the DP is each mission's own (it knows the mission's Sun,
+`orbit_env.agents.solar_dp`), solved per mission in worker processes; the burns it asks
+for are its plan, replayed first in the vector env (its return must come back: the
+replay's difference is reported), and the search runs from there on the missions of
+``orbit-env evaluate --env OrbitRaisingSolar-v0`` (same seed, split and rule).
 """
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import gymnasium
 import numpy as np
@@ -64,6 +72,7 @@ class Certificate:
     wall_s: float
     plans_scored: int
     replay_max_error: float = field(default=0.0)
+    start_dates: tuple[str, ...] = ()  # the solar task's missions' first days
 
     @property
     def gaps(self) -> FloatArray:
@@ -82,6 +91,7 @@ class Certificate:
             "worst_gap_days": float(gaps[worst]),
             "worst_episode": worst,
             "worst_start_km": [float(self.perigee_km[worst]), float(self.apogee_km[worst])],
+            **({"worst_start_date": self.start_dates[worst]} if self.start_dates else {}),
             "beaten_above_0.1_day": int(np.sum(gaps > 0.1)),
             "beaten_at_all": int(np.sum(gaps > TIE_DAYS)),
             "dp_mean_return": float(self.dp_returns.mean()),
@@ -92,17 +102,23 @@ class Certificate:
 
 
 class _Plans:
-    """Scoring action plans (one row per start and candidate) in the vector env."""
+    """Scoring action plans (one row per start and candidate) in the vector env.
 
-    def __init__(self, env_id: str, perigee_km: FloatArray, apogee_km: FloatArray) -> None:
+    ``options`` are the starts' reset options, arrays over the starts (the known-density
+    envs' heights, or the solar task's `orbit_env.envs.solar_task.start_options`).
+    """
+
+    def __init__(self, env_id: str, options: dict[str, FloatArray], env_kwargs: dict[str, Any] | None = None) -> None:
         self.env_id = env_id
-        base = task_of(env_id)
-        self.continuous = base.continuous
-        self.horizon = base.config.horizon_steps
-        self.max_burn = base.config.max_burn_m_s
-        self.sizes = np.asarray(base.config.burn_sizes_m_s, dtype=np.float64)
-        self.perigee_km = perigee_km
-        self.apogee_km = apogee_km
+        self.env_kwargs = dict(env_kwargs or {})
+        probe = gymnasium.make(env_id, **self.env_kwargs)
+        task = probe.unwrapped.task
+        probe.close()
+        self.continuous = task.continuous
+        self.horizon = task.config.horizon_steps
+        self.max_burn = task.config.max_burn_m_s
+        self.sizes = np.asarray(task.config.burn_sizes_m_s, dtype=np.float64)
+        self.options = options
         self.scored = 0
 
     def actions(self, burns_m_s: FloatArray) -> Any:
@@ -117,8 +133,8 @@ class _Plans:
         With ``policy`` the plans are ignored and the policy acts; then also its burns.
         """
         k = starts.size
-        env = gymnasium.make_vec(self.env_id, num_envs=k)
-        obs, _ = env.reset(seed=0, options={"perigee_km": self.perigee_km[starts], "apogee_km": self.apogee_km[starts]})
+        env = gymnasium.make_vec(self.env_id, num_envs=k, **self.env_kwargs)
+        obs, _ = env.reset(seed=0, options={key: value[starts] for key, value in self.options.items()})
         returns = np.zeros(k)
         made = np.zeros((k, self.horizon))
         running = np.ones(k, dtype=bool)
@@ -143,10 +159,8 @@ class _Plans:
 
     def replay(self, start: int, burns_m_s: FloatArray) -> float:
         """The plan's return in ``gymnasium.make`` (one environment)."""
-        env = gymnasium.make(self.env_id)
-        env.reset(
-            seed=0, options={"perigee_km": float(self.perigee_km[start]), "apogee_km": float(self.apogee_km[start])}
-        )
+        env = gymnasium.make(self.env_id, **self.env_kwargs)
+        env.reset(seed=0, options={key: float(value[start]) for key, value in self.options.items()})
         total = 0.0
         for t in range(self.horizon):
             action = self.actions(burns_m_s[t : t + 1])[0]
@@ -206,6 +220,96 @@ def _perturb(plan: FloatArray, rng: np.random.Generator, plans: _Plans) -> Float
     return new
 
 
+class _Optimum(NamedTuple):
+    """The starts (as plans are scored from them) and the DP policy on them."""
+
+    plans: _Plans
+    returns: FloatArray
+    burns_m_s: FloatArray  # (starts, horizon): its plan
+    start_dates: tuple[str, ...] = ()  # the solar task's missions' first days
+
+
+def _start_heights(plans: _Plans) -> tuple[FloatArray, FloatArray]:
+    """The starts' perigee and apogee heights [km]: the options', or the env's task state after its reset."""
+    if "perigee_km" in plans.options:
+        return plans.options["perigee_km"], plans.options["apogee_km"]
+    env = gymnasium.make_vec(plans.env_id, num_envs=len(next(iter(plans.options.values()))), **plans.env_kwargs)
+    env.reset(seed=0, options=plans.options)
+    state = env.unwrapped.task_state
+    heights = state.perigee_m / 1e3, state.apogee_m / 1e3
+    env.close()
+    return heights
+
+
+def _known_density_optimum(
+    env_id: str, episodes: int, seed: int, policy: Predictor | None, dp_lookahead: int, dp_rollout: bool
+) -> _Optimum:
+    """The seeded starts' plans, and the DP policy's returns and burns on them (a known-density env)."""
+    check_env_id(env_id)
+    base = task_of(env_id)
+    if base.density.scale_range[0] != base.density.scale_range[1] or base.density.varies:
+        raise ValueError(f"{env_id}: the certificate needs a known, constant density (the DP's task)")
+    env = gymnasium.make_vec(env_id, num_envs=episodes)
+    env.reset(seed=seed)
+    heights = {"perigee_km": env.unwrapped.state["perigee_m"] / 1e3, "apogee_km": env.unwrapped.state["apogee_m"] / 1e3}
+    env.close()
+    plans = _Plans(env_id, heights)
+    zero = np.zeros((episodes, plans.horizon))
+    returns, burns = plans.score(np.arange(episodes), zero, policy or dp_policy(env_id, dp_lookahead, dp_rollout))
+    return _Optimum(plans, returns, burns)
+
+
+def _solar_plan(job: tuple[Any, dict[str, float]]) -> tuple[float, list[float]]:
+    """One mission's DP solved and flown (in a worker): its return and the burns it asked for, step by step."""
+    from orbit_env.agents.solar import fly
+    from orbit_env.agents.solar_dp import SolarDP
+
+    task, option = job
+    dp = SolarDP(task, option["start_day"])
+    asked: list[float] = []
+
+    def act(state: Any) -> FloatArray:
+        burn = dp.burns_m_s(state)
+        asked.append(float(burn[0]))
+        return burn
+
+    flown = fly(task, {key: np.array([value]) for key, value in option.items()}, act)
+    return float(flown.returns[0]), asked
+
+
+def _solar_optimum(
+    episodes: int, seed: int, env_kwargs: dict[str, Any], workers: int | None, say: Callable[[str], None]
+) -> _Optimum:
+    """The solar task's seeded missions, and each one's DP (`orbit_env.agents.solar_dp.SolarDP`) flown.
+
+    The DP acts on the task's state (it knows the Sun's future); the burns it asks for
+    are recorded as its plan, which the search then replays and perturbs in the env. The
+    DPs are solved in ``workers`` processes (default: the cores, at most 8), as ``evaluate`` does.
+    """
+    from orbit_env.agents.solar import starts
+    from orbit_env.envs import SOLAR_ENV_ID, solar_task
+
+    probe = gymnasium.make(SOLAR_ENV_ID, **env_kwargs)
+    task = probe.unwrapped.task
+    probe.close()
+    options = starts(task, episodes, seed)
+    plans = _Plans(SOLAR_ENV_ID, options, env_kwargs)
+    jobs = [(task, {key: float(value[i]) for key, value in options.items()}) for i in range(episodes)]
+    say(f"dp: {episodes} missions, one DP each")
+    count = workers or min(os.cpu_count() or 1, 8)
+    if count > 1 and episodes > 1:
+        with ProcessPoolExecutor(count) as pool:
+            solved = list(pool.map(_solar_plan, jobs))
+    else:
+        solved = [_solar_plan(job) for job in jobs]
+    returns, burns = np.zeros(episodes), np.zeros((episodes, plans.horizon))
+    for i, (value, asked) in enumerate(solved):
+        returns[i] = value
+        burns[i, : len(asked)] = asked
+    dates = tuple(solar_task.date_of(task, float(day)) for day in options["start_day"])
+    return _Optimum(plans, returns, burns, dates)
+
+
 def certify(
     env_id: str = "OrbitRaising-v0",
     episodes: int = 1000,
@@ -216,44 +320,46 @@ def certify(
     policy: Predictor | None = None,
     dp_lookahead: int = 1,
     dp_rollout: bool = False,
+    env_kwargs: dict[str, Any] | None = None,
+    workers: int | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> Certificate:
     """Search for plans that beat the DP policy on ``episodes`` seeded starts (see the module).
 
     Args:
-        env_id: A known-density environment (``OrbitRaising-v0``, ``OrbitRaisingContinuous-v0``).
+        env_id: A known-density environment (``OrbitRaising-v0``, ``OrbitRaisingContinuous-v0``),
+            or ``OrbitRaisingSolar-v0`` (each mission's DP that knows its Sun).
         episodes: Start orbits, those of ``orbit-env evaluate`` with the same seed.
         seed: Seed of the starts.
         rounds: Rounds of hill climbing.
         perturbations: Random changes tried per start and round.
-        policy: The policy to certify (default: the env's DP policy).
+        policy: The policy to certify (default: the env's DP policy; known-density envs).
         dp_lookahead: The DP policy's ``lookahead`` (`orbit_env.agents.dp.DPPolicy`).
         dp_rollout: Certify the rollout policy on the DP (`orbit_env.agents.evaluate.dp_policy`).
+        env_kwargs: The solar env's keywords (``solar_split``, default ``test`` as ``evaluate``'s; ``disposal_years``).
+        workers: Processes solving the solar task's DPs (default: the cores, at most 8).
         progress: Called with a line of text as the search goes.
 
     Raises:
         ValueError: an unknown env, one whose density is not known (its optimum is the
             oracle's), or counts below 1.
     """
-    check_env_id(env_id)
-    base = task_of(env_id)
-    if base.density.scale_range[0] != base.density.scale_range[1] or base.density.varies:
-        raise ValueError(f"{env_id}: the certificate needs a known, constant density (the DP's task)")
+    from orbit_env.envs import SOLAR_ENV_ID
+
     if episodes < 1 or rounds < 0 or perturbations < 1:
         raise ValueError("episodes and perturbations must be >= 1, rounds >= 0")
     say = progress or (lambda text: None)
     start_time = time.perf_counter()
-    env = gymnasium.make_vec(env_id, num_envs=episodes)
-    env.reset(seed=seed)
-    perigee_km = env.unwrapped.state["perigee_m"] / 1e3
-    apogee_km = env.unwrapped.state["apogee_m"] / 1e3
-    env.close()
-    plans = _Plans(env_id, perigee_km, apogee_km)
-    everyone = np.arange(episodes)
     say("dp (solving and playing)")
-    dp_returns, dp_burns = plans.score(
-        everyone, np.zeros((episodes, plans.horizon)), policy or dp_policy(env_id, dp_lookahead, dp_rollout)
-    )
+    if env_id == SOLAR_ENV_ID:
+        optimum = _solar_optimum(episodes, seed, {"solar_split": "test", **(env_kwargs or {})}, workers, say)
+    else:
+        optimum = _known_density_optimum(env_id, episodes, seed, policy, dp_lookahead, dp_rollout)
+    plans, dp_returns, dp_burns = optimum.plans, optimum.returns, optimum.burns_m_s
+    everyone = np.arange(episodes)
+    replay_error = 0.0
+    if env_id == SOLAR_ENV_ID:  # the burns the DP asked for, as an open-loop plan in the env, give its return back
+        replay_error = float(np.max(np.abs(plans.score(everyone, dp_burns) - dp_returns)))
     best, best_returns = dp_burns.copy(), dp_returns.copy()
     early = _early_plans(plans)
     say(f"{early.shape[0]} early plans per start")
@@ -278,21 +384,22 @@ def certify(
         gap = np.maximum(best_returns - dp_returns, 0.0)
         say(f"round {r + 1}/{rounds}: mean gap {gap.mean():.3f} day, worst {gap.max():.3f}")
     # The plans that beat the DP, replayed one by one in gymnasium.make: the returns reported.
-    replay_error = 0.0
     for i in np.flatnonzero(best_returns - dp_returns > TIE_DAYS):
         replayed = plans.replay(int(i), best[i])
         replay_error = max(replay_error, abs(replayed - best_returns[i]))
         best_returns[i] = replayed
+    heights = _start_heights(plans)
     return Certificate(
         env_id=env_id,
         seed=seed,
         dp_returns=dp_returns,
         best_returns=best_returns,
-        perigee_km=perigee_km,
-        apogee_km=apogee_km,
+        perigee_km=heights[0],
+        apogee_km=heights[1],
         wall_s=time.perf_counter() - start_time,
         plans_scored=plans.scored,
         replay_max_error=replay_error,
+        start_dates=optimum.start_dates,
     )
 
 
@@ -305,9 +412,11 @@ def format_certificate(summary: dict[str, Any]) -> str:
             f"DP policy's mean return {summary['dp_mean_return']:.3f} days",
             f"gap found (best plan - DP policy): mean {summary['mean_gap_days']:.3f} day, "
             f"worst {summary['worst_gap_days']:.3f} day (episode {summary['worst_episode']}, "
-            f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km)",
+            f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km"
+            + (f", from {summary['worst_start_date']})" if "worst_start_date" in summary else ")"),
             f"starts where the DP was beaten: {summary['beaten_at_all']} by more than {TIE_DAYS} day, "
             f"{summary['beaten_above_0.1_day']} by more than 0.1 day",
-            f"winners replayed in gymnasium.make: largest difference {summary['replay_max_error_days']:.1e} day",
+            f"plans replayed (the winners in gymnasium.make; the solar DP's own in the vector env): largest "
+            f"difference {summary['replay_max_error_days']:.1e} day",
         ]
     )

@@ -57,3 +57,24 @@ def test_certify_summary_is_json():
     certificate = certify("OrbitRaising-v0", episodes=3, seed=1, rounds=0, perturbations=1, policy=NeverBurn())
     out = json.loads(json.dumps(certificate.summary()))
     assert out["episodes"] == 3 and out["env"] == "OrbitRaising-v0"
+
+
+def test_the_solar_certificate_flies_each_missions_own_dp_and_replays_its_plan():
+    from orbit_env.agents.solar import fly, starts
+    from orbit_env.agents.solar_dp import SolarDP
+
+    certificate = certify("OrbitRaisingSolar-v0", episodes=2, seed=5, rounds=1, perturbations=3, workers=1)
+    summary = certificate.summary()
+    # The reference is each mission's DP flown on the task model, as evaluate's dp row flies it.
+    task = gym.make("OrbitRaisingSolar-v0", solar_split="test").unwrapped.task  # certify's default, as evaluate's
+    options = starts(task, 2, 5)
+    for i in range(2):
+        one = {key: value[i : i + 1] for key, value in options.items()}
+        dp = SolarDP(task, float(one["start_day"][0]))
+        assert fly(task, one, dp.burns_m_s).returns[0] == pytest.approx(certificate.dp_returns[i], abs=1e-9)
+    # The DP's burns replayed open-loop in the vector env give its return back.
+    assert summary["replay_max_error_days"] < 1e-9
+    assert np.all(certificate.best_returns >= certificate.dp_returns - 1e-9)
+    assert summary["plans_scored"] == 2 * (1 + 64 + 3)  # the DP's plan, 4^3 early plans, the perturbations
+    # The test split's missions start on or after 2009-01-01.
+    assert summary["worst_start_date"] >= "2009-01-01" and len(summary["worst_start_date"]) == 10

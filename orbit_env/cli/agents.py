@@ -51,11 +51,11 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     from orbit_env.envs import SOLAR_ENV_ID
 
+    if args.certify:
+        return _certify(args, say)
     if args.env == SOLAR_ENV_ID:
         return _evaluate_solar(args, say)
     check_env_id(args.env)
-    if args.certify:
-        return _certify(args, say)
     policies = all_policies(
         args.env,
         model_path=args.model,
@@ -146,9 +146,18 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
 
 def _certify(args: argparse.Namespace, say: Any) -> int:
     from orbit_env.agents.certify import certify, format_certificate
+    from orbit_env.envs import SOLAR_ENV_ID
 
+    solar = {"solar_split": args.solar_split, "disposal_years": args.disposal_years}
     certificate = certify(
-        args.env, args.episodes, args.seed, dp_lookahead=args.dp_lookahead, dp_rollout=args.dp_rollout, progress=say
+        args.env,
+        args.episodes,
+        args.seed,
+        dp_lookahead=args.dp_lookahead,
+        dp_rollout=args.dp_rollout,
+        env_kwargs=solar if args.env == SOLAR_ENV_ID else None,
+        workers=args.workers,
+        progress=say,
     )
     summary = certificate.summary()
     print(json.dumps(summary) if args.json else format_certificate(summary))
@@ -253,7 +262,7 @@ def add_parsers(sub: Any) -> None:
         "--workers",
         type=positive_int,
         metavar="N",
-        help="OrbitRaisingSolar-v0: processes solving the DPs (default: cores)",
+        help="OrbitRaisingSolar-v0: processes solving the DPs, also with --certify (default: cores)",
     )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
