@@ -29,7 +29,7 @@ from orbit_env.agents.evaluate import Episodes
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.envs import solar_task
 from orbit_env.envs import task as task_model
-from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SolarMission, SolarTask
+from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SolarMission, SolarStep, SolarTask
 from orbit_env.envs.state import BatchState
 from orbit_env.envs.task import DV_SCALE_M_S, HEIGHT_SCALE_M, LIFETIME_SCALE_DAYS
 from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
@@ -187,8 +187,17 @@ def starts(task: SolarTask, episodes: int, seed: int) -> dict[str, FloatArray]:
     return solar_task.start_options(solar_task.start(task, np.random.default_rng(seed), episodes))
 
 
-def fly(task: SolarTask, options: Mapping[str, Any], act: Callable[[BatchState], FloatArray]) -> Flown:
-    """Fly the missions of ``options`` with ``act`` (states -> burns requested [m/s]) to their ends."""
+def fly(
+    task: SolarTask,
+    options: Mapping[str, Any],
+    act: Callable[[BatchState], FloatArray],
+    on_step: Callable[[NDArray[np.intp], BatchState, SolarStep], None] | None = None,
+) -> Flown:
+    """Fly the missions of ``options`` with ``act`` (states -> burns requested [m/s]) to their ends.
+
+    ``on_step(rows, states, result)``, if given, sees each step of the missions still flying: their
+    rows, their states after the step and its result (`orbit_env.agents.solar_maps` records the flights).
+    """
     n = len(options["start_day"])
     state = solar_task.start(task, np.random.default_rng(0), n, options)
     total, dv, disposal = np.zeros(n), np.zeros(n), np.zeros(n)
@@ -199,6 +208,8 @@ def fly(task: SolarTask, options: Mapping[str, Any], act: Callable[[BatchState],
         sub = state.take(rows)
         result = solar_task.step(task, sub, act(sub))
         state.put(rows, sub)
+        if on_step is not None:
+            on_step(rows, sub, result)
         total[rows] += result.reward
         dv[rows] += result.burn_m_s + result.disposal_m_s
         disposal[rows] += result.disposal_m_s
