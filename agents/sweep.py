@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -121,16 +121,28 @@ def format_table(env_id: str, rows: list[dict[str, Any]], timesteps: int) -> str
 
 
 def train_trial(
-    env_id: str, algo: str, seed: int, timesteps: int, out_dir: str | Path, num_envs: int = SWEEP_NUM_ENVS
+    env_id: str,
+    algo: str,
+    seed: int,
+    timesteps: int,
+    out_dir: str | Path,
+    num_envs: int = SWEEP_NUM_ENVS,
+    *,
+    callbacks: Sequence[Any] = (),
 ) -> Path:
-    """Train one algorithm with one seed; return where its model went."""
+    """Train one algorithm with one seed; return where its model went.
+
+    ``callbacks``: SB3 callbacks that see the training (`orbit_env.agents.curves` scores the policy with one).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if algo == "ppo_recipe":
         from orbit_env.agents.train import train
 
         config = resources.files("orbit_env.agents").joinpath(RECIPES[env_id])
-        result = train(config, out, total_timesteps=timesteps, seed=seed, progress=False, force=True)
+        result = train(
+            config, out, total_timesteps=timesteps, seed=seed, progress=False, force=True, extra_callbacks=callbacks
+        )
         return result.model_path
     import stable_baselines3
     import torch
@@ -140,39 +152,50 @@ def train_trial(
     torch.set_num_threads(1)
     venv = make_sb3_vec_env(env_id, num_envs=num_envs, seed=seed)  # monitored: SB3's episode statistics
     model = getattr(stable_baselines3, algo.upper())("MlpPolicy", venv, seed=seed, device="cpu", verbose=0)
-    model.learn(total_timesteps=timesteps)
+    model.learn(total_timesteps=timesteps, callback=list(callbacks) or None)
     model.orbit_env = {"env_id": env_id, "env": {}}
     path = out / "model.zip"
     model.save(path, exclude=["env", "tensorboard_log"])
     return path
 
 
-def run_trial(config: dict[str, Any]) -> dict[str, Any]:
-    """One trial (Ray Tune's function trainable): train, then score on the evaluation episodes.
+def score_model(env_id: str, model: Any, episodes: int, eval_seed: int) -> float:
+    """A model's mean return on the evaluation episodes, deterministic actions, as ``orbit-env evaluate`` scores it.
 
-    The solar task's trials fly the missions of ``config["solar_split"]``, as `orbit_env.agents.solar.evaluate_solar`.
+    The solar task flies the missions of the held-out `SOLAR_EVAL_SPLIT` (`orbit_env.agents.solar.fly_model`).
     """
-    from orbit_env.agents.evaluate import load_model, run_episodes
+    from orbit_env.envs import SOLAR_ENV_ID
+
+    if env_id == SOLAR_ENV_ID:
+        from orbit_env.agents.solar import fly_model
+
+        return float(fly_model(model, episodes, eval_seed, {"solar_split": SOLAR_EVAL_SPLIT}).returns.mean())
+    from orbit_env.agents.evaluate import run_episodes
+
+    return float(run_episodes(env_id, model, episodes, eval_seed).returns.mean())
+
+
+def capture_of(mean_return: float, references: dict[str, Any]) -> float | None:
+    """(R - R_never) / (R_dp - R_never); None without the DP's return (or when never is optimal)."""
+    never, dp = references.get("never_return"), references.get("dp_return")
+    return None if never is None or dp is None or abs(dp - never) < 1e-9 else (mean_return - never) / (dp - never)
+
+
+def run_trial(config: dict[str, Any]) -> dict[str, Any]:
+    """One trial (Ray Tune's function trainable): train, then score on the evaluation episodes (`score_model`)."""
+    from orbit_env.agents.evaluate import load_model
 
     start = time.perf_counter()
-    env_id, episodes, eval_seed = config["env_id"], int(config["episodes"]), int(config["eval_seed"])
+    env_id = config["env_id"]
     trial_dir = Path(config["out"]) / "trials" / f"{config['algo']}_seed{config['seed']}"
     path = train_trial(env_id, config["algo"], int(config["seed"]), int(config["timesteps"]), trial_dir)
     _, model = load_model(env_id, path)
-    if "solar_split" in config:
-        from orbit_env.agents.solar import fly_model
-
-        returns = fly_model(model, episodes, eval_seed, {"solar_split": config["solar_split"]}).returns
-    else:
-        returns = run_episodes(env_id, model, episodes, eval_seed).returns
-    mean = float(returns.mean())
-    never, dp = config.get("never_return"), config.get("dp_return")
-    capture = None if never is None or dp is None or abs(dp - never) < 1e-9 else (mean - never) / (dp - never)
+    mean = score_model(env_id, model, int(config["episodes"]), int(config["eval_seed"]))
     return {
         "algo": config["algo"],
         "seed": int(config["seed"]),
         "mean_return": mean,
-        "capture": capture,
+        "capture": capture_of(mean, config),
         "wall_s": time.perf_counter() - start,
         "model": str(path),
     }

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 import time
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -432,6 +432,7 @@ def train(
     resume: str | Path | None = None,
     force: bool = False,
     progress: bool = True,
+    extra_callbacks: Sequence[Any] = (),
 ) -> TrainResult:
     """Train PPO as the config says; return where the model went.
 
@@ -454,6 +455,7 @@ def train(
             up to the same total budget.
         force: Overwrite a finished run in ``out_dir`` (otherwise it is kept: ValueError).
         progress: Show a progress bar.
+        extra_callbacks: More SB3 callbacks that see the training (`orbit_env.agents.curves` scores the policy).
 
     Raises:
         ValueError: a bad config or argument, a finished run in ``out_dir`` without
@@ -520,6 +522,7 @@ def train(
             resume=checkpoint is not None,
         )
         callbacks.append(best)
+    callbacks.extend(extra_callbacks)
     remaining = max(timesteps - int(model.num_timesteps), 0)
     start = time.perf_counter()
     if remaining > 0:

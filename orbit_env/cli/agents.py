@@ -194,8 +194,29 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_curves(args: argparse.Namespace) -> int:
+    from orbit_env.agents.curves import curves, format_curves, plot_curves
+
+    algos = [a.strip() for a in args.algos.split(",") if a.strip()]
+    result = curves(
+        args.env,
+        algos,
+        args.seeds,
+        args.timesteps,
+        args.every,
+        args.out,
+        episodes=args.episodes,
+        workers=args.workers,
+        progress=lambda text: print(f"  {text} ...", file=sys.stderr),
+    )
+    if args.plot:
+        plot_curves(result, args.plot)
+    print(json.dumps(result) if args.json else format_curves(result))
+    return 0
+
+
 def add_parsers(sub: Any) -> None:
-    """The ``train`` and ``evaluate`` commands."""
+    """The ``train``, ``evaluate``, ``sweep`` and ``curves`` commands."""
     tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
     tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
     tr.add_argument("--out", default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)")
@@ -293,3 +314,26 @@ def add_parsers(sub: Any) -> None:
         help="OrbitRaisingSolar-v0: processes solving the references' DPs (default: cores)",
     )
     sw.set_defaults(func=_cmd_sweep)
+
+    cu = sub.add_parser(
+        "curves", help="the benchmark protocol: capture against steps over seeds, IQM with bootstrap CIs (resumable)"
+    )
+    cu.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")
+    cu.add_argument("--algos", default="ppo,ppo_recipe", metavar="A,B", help="ppo (SB3 defaults), ppo_recipe")
+    cu.add_argument("--seeds", type=positive_int, default=5, metavar="N", help="seeds 0..N-1 (default 5)")
+    cu.add_argument("--timesteps", type=positive_int, default=2_000_000, metavar="T", help="per run (default 2M)")
+    cu.add_argument(
+        "--every", type=positive_int, default=200_000, metavar="T", help="steps between points (default 200k)"
+    )
+    cu.add_argument(
+        "--episodes",
+        type=positive_int,
+        default=EVAL_EPISODES,
+        metavar="N",
+        help=f"evaluation episodes, seed {EVAL_SEED} (default {EVAL_EPISODES})",
+    )
+    cu.add_argument("--workers", type=positive_int, default=1, metavar="N", help="runs at once (default 1)")
+    cu.add_argument("--out", required=True, metavar="DIR", help="the runs' curves and results.json (resumable)")
+    cu.add_argument("--plot", metavar="PNG", help="draw the curves")
+    cu.add_argument("--json", action="store_true", help="print results.json's content")
+    cu.set_defaults(func=_cmd_curves)
