@@ -169,7 +169,9 @@ def test_the_shipped_baseline_tables_are_complete():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("env_id", ["OrbitRaising-v0", "OrbitRaisingContinuous-v0", "OrbitRaisingUncertain-v0"])
+@pytest.mark.parametrize(
+    "env_id", ["OrbitRaising-v0", "OrbitRaisingContinuous-v0", "OrbitRaisingUncertain-v0", "OrbitRaisingSolar-v0"]
+)
 def test_the_shipped_baselines_are_of_the_current_model(env_id):
     """The shipped captures were measured against today's references, not a former model's.
 
