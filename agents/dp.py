@@ -181,7 +181,7 @@ def _coast_certain_stages(model: DPModel) -> int:
     domain (P grows convexly with the perigee speed, so a finite burn gains
     less per m/s than the rate at its end, which lies in the domain; assumed:
     the difference of the periods does not grow as both orbits decay, checked by
-    solving with every state deciding in tests/test_dp.py). Returns the largest
+    solving with every state deciding in tests/agents/test_dp.py). Returns the largest
     k with c0 * k < cost, at most the horizon.
     """
     config = model.config

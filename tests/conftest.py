@@ -1,6 +1,11 @@
 import os
+import sys
+from pathlib import Path
 
 from hypothesis import HealthCheck, settings
+
+# tests/ mirrors the package's folders; the helpers at its root (benchmark_scripts) are imported from any of them.
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 # CI machines are shared and noisy: no deadline; fewer examples keep the default run short.
 settings.register_profile("ci", deadline=None, max_examples=60, suppress_health_check=[HealthCheck.too_slow])

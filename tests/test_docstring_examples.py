@@ -2,7 +2,7 @@
 
 griffe (the documentation's docstring parser) reads a Google-style ``Examples:`` section as
 examples; an ``Example:`` section or a bare ``>>>`` paragraph renders as nested quote blocks.
-The env modules' examples run in tests/test_envs.py (they need stable-baselines3).
+The env modules' examples run in tests/envs/test_envs.py (they need stable-baselines3).
 """
 
 import doctest

@@ -26,7 +26,7 @@ README = (ROOT / "README.md").read_text()
 HOWTO = (ROOT / "docs" / "how-to" / "lifetime.md").read_text()
 #: Console commands README shows but these tests do not run, and why.
 SLOW = {
-    "orbit-env evaluate": "solves the DP optimum on a cold cache (tens of seconds); tests/test_agents.py scores it",
+    "orbit-env evaluate": "solves the DP optimum on a cold cache (tens of s); tests/agents/test_agents.py runs it",
     "python benchmarks/bench_all.py": "timings depend on the machine",
 }
 

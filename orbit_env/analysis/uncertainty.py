@@ -34,7 +34,7 @@ node at once, a vector of satellites each with its own density and drag factor; 
 sample's lifetime is then interpolated in z between the two nodes around it (linearly
 in log days). A node propagates only its own samples (the outer nodes about a sixth of
 them), so it stops when they have re-entered, not the longest-lived of all. The
-interpolation error is measured in ``tests/test_uncertainty.py`` against samples
+interpolation error is measured in ``tests/analysis/test_uncertainty.py`` against samples
 propagated one by one. (A grid in the factor as well is cheaper but misses by up to 4%:
 the lifetime is not smooth in the factor where the fall meets a turn of the solar cycle.)
 """

@@ -36,7 +36,7 @@ spaced anomalies. The integrands are smooth and periodic, so the rule converges
 geometrically; with 64 points its relative error is below 3e-4 everywhere in the
 domain of the universal curves (the density law has kinks at 150 and 250 km,
 which make the rule second order there), measured in
-``tests/test_decay.py`` against 1024 points.
+``tests/decay/test_decay.py`` against 1024 points.
 """
 
 from __future__ import annotations

@@ -29,7 +29,7 @@ again after a burn then sees one function W along each curve, so a step's time
 
 Accuracy: against the averaged ODE solved with DOP853 at rtol 1e-9 the lifetime
 from the curves differs by at most 0.5% for lifetimes nu >= 0.1 (Table II's
-smallest cell) over the domain (``tests/test_curves.py`` measures it on random
+smallest cell) over the domain (``tests/decay/test_curves.py`` measures it on random
 orbits; measured maximum 0.06% on 300 random orbits).
 """
 
@@ -329,7 +329,7 @@ def _spline_rows(x: FloatArray, y: FloatArray, counts: NDArray[np.intp], query: 
     The spline of each row is scipy's default, not-a-knot at both ends, built the
     same way (first derivatives at the knots from one tridiagonal system, then the
     Hermite cubic of each interval), so it agrees with ``CubicSpline`` to round-off
-    (``tests/test_curves.py`` compares them). The rows' systems are solved together
+    (``tests/decay/test_curves.py`` compares them). The rows' systems are solved together
     by the Thomas algorithm, a sweep over the knots vectorized over the rows: its
     pivots stay nonzero for not-a-knot ends on increasing knots, where scipy's
     banded solver pivots. Importing scipy.interpolate alone costs longer than the

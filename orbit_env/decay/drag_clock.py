@@ -160,7 +160,7 @@ def drag_clock(inclination_deg: float = 53.0, version: float = DEFAULT_MSIS_VERS
 def drag_days_at(cumulative: FloatArray, perigee_m: float, first_day: float, last_day: float) -> float:
     """`drag_days` of one orbit in plain floats (the same operations), for the compiled solar task.
 
-    ``orbit_env.envs.solar_kernel`` compiles it with numba; ``tests/test_solar_task.py`` holds it
+    ``orbit_env.envs.solar_kernel`` compiles it with numba; ``tests/envs/test_solar_task.py`` holds it
     equal to the array form.
     """
     x = min(max((perigee_m - GRID_FIRST_M) / GRID_STEP_M, 0.0), GRID_TOP)

@@ -19,7 +19,7 @@ exactly the lifetime in the time-mean profile over that lifetime. So here:
 The approximation is not exact (the scale height changes with activity, so
 rho(h, t) does not factor), and it is measured where both paths exist, inside
 the curves' domain, against the time-stepped curves (docs/validation-modern.md,
-"Dated lifetimes above the curves"; ``tests/test_lifetime_mean.py``).
+"Dated lifetimes above the curves"; ``tests/decay/test_lifetime_mean.py``).
 """
 
 from __future__ import annotations

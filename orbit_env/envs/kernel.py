@@ -20,7 +20,7 @@ The contract with the task model is declared once: the state's rows are
 
 The numpy task model stays the definition and the fallback: `orbit_env.envs.task` steps
 with it when numba is not installed, when ``ORBIT_ENV_JIT=0`` is set, or for more than
-`MAX_COMPILED_ROWS` burning satellites (where numpy's SIMD wins). ``tests/test_kernel.py``
+`MAX_COMPILED_ROWS` burning satellites (where numpy's SIMD wins). ``tests/envs/test_kernel.py``
 steps both side by side through random burns, the apogee cap, empty tanks, re-entries and
 restarts of every variant and holds them equal to round-off (the only differences are the
 last bits of ``exp``, ``log``, ``expm1`` and ``sin``, the C library's against numpy's; the
@@ -247,7 +247,7 @@ def _sine(x: float) -> float:
 
     fdlibm's method: x = n pi/2 + r, |r| <= pi/4, then its sine or cosine polynomial
     by the quadrant n mod 4. Within 1.2e-16 of the C library's ``sin`` for
-    |x| <= `_SINE_REDUCTION_LIMIT` (tests/test_kernel.py); callers take the C library's beyond.
+    |x| <= `_SINE_REDUCTION_LIMIT` (tests/envs/test_kernel.py); callers take the C library's beyond.
     """
     n = math.floor(x * _INV_PIO2 + 0.5)
     r = (x - n * _PIO2_1) - n * _PIO2_1T

@@ -13,7 +13,7 @@ They read the tables the rest of the package reads: table A (where heights fall 
 curves) and table B (heights and period along a curve) of the drag clock's universal
 curves as `orbit_env.envs.kernel` reads them (`orbit_env.envs.kernel.tables`, its
 `orbit_env.envs.kernel.cell`), and the clock's cumulative drag-days
-(`orbit_env.decay.drag_clock.drag_days_at`). ``tests/test_solar_task.py`` holds the
+(`orbit_env.decay.drag_clock.drag_days_at`). ``tests/envs/test_solar_task.py`` holds the
 compiled loops equal to the uncompiled functions and the coast equal to the array
 lookups of `orbit_env.decay.curves.UniversalCurves` (``weighted_at``, ``nu_at_weight``).
 

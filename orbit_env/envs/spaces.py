@@ -15,7 +15,7 @@ class UniformBox(spaces.Box):
     Gymnasium's ``Box.sample`` sorts the coordinates into bounded, half-bounded and
     unbounded ones with a dozen numpy calls (about 20 us, three CartPole steps). For a
     float box bounded on every side that comes down to one uniform draw, made here
-    directly: the same numbers from the same generator (``tests/test_fast_paths.py``
+    directly: the same numbers from the same generator (``tests/envs/test_fast_paths.py``
     compares them with ``Box.sample``'s). Bounds equal on every coordinate are
     passed as two floats, with which numpy's ``uniform`` is five times faster
     than with arrays.

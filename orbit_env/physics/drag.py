@@ -23,7 +23,7 @@ the air comes from (``gamma = cos theta``: 1 facing the flow, 0 parallel to it,
     C_D = P / sqrt(pi) + gamma Q Z + (gamma / 2) (v_re / V) (gamma sqrt(pi) Z + P)
 
 with ``P = exp(-gamma^2 S^2) / S``, ``Q = 1 + 1 / (2 S^2)``, ``Z = 1 + erf(gamma S)``.
-Limits, checked in ``tests/test_drag.py``: a plate facing the flow gives
+Limits, checked in ``tests/physics/test_drag.py``: a plate facing the flow gives
 ``2 + 1/S^2 + sqrt(pi) v_re / V`` (about 2.1); a plate parallel to it gives the
 pure shear ``1 / (S sqrt(pi))`` (about 0.08); the wake side gives ~0.
 

@@ -119,7 +119,7 @@ def mean_to_flown_radius_offset_m(semi_major_axis_m: ArrayLike, inclination_deg:
     *Fundamentals of Astrodynamics and Applications*, 4th ed., 2013, section 9.6): about
     -9.7 km at 0 deg, -0.8 km at 51.6 deg and +4.6 km at 97.5 deg for a 400 km orbit. The
     decay integrates the orbit flown, so the heights of an element set move by this much.
-    Tested against SGP4's own propagation (``tests/test_elements.py``).
+    Tested against SGP4's own propagation (``tests/analysis/test_elements.py``).
     """
     a_m = check_array(semi_major_axis_m, "semi_major_axis_m", unit="m", low=EARTH_EQUATORIAL_RADIUS_M)
     sin_i = np.sin(np.radians(check_array(inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)))

@@ -46,7 +46,7 @@ Table: ``ALTITUDE_GRID_M`` (40-6000 km, 2 km steps where the scale height is sho
 below 40 km the 40 km value is held: no decay computed here reaches that low);
 log-density is interpolated linearly (it is nearly linear between nodes: the
 relative error is below 1e-3 from 150 to 1000 km and below 4e-3 elsewhere,
-measured in ``tests/test_msis.py``),
+measured in ``tests/physics/test_msis.py``),
 and extrapolated above the grid with its top slope. Building a table costs about
 0.3 s (~600 000 NRLMSIS points) and is cached per condition, so the universal
 curves of `orbit_env.decay.curves` can be built and cached per profile too.

@@ -233,7 +233,7 @@ def test_the_module_id_form_registers_the_envs_itself():
     # The page that says so.
     from pathlib import Path
 
-    page = Path(__file__).parents[1] / "docs" / "getting-started.md"
+    page = Path(__file__).parents[2] / "docs" / "getting-started.md"
     assert 'gym.make("orbit_env:OrbitRaising-v0")' in page.read_text()
 
 
@@ -252,7 +252,7 @@ def test_version_history_records_the_burn_relocation_fix(env_id):
         history = doc[doc.index("Version History") :]
         assert "2026-12-03" in history and "burn relocation fix" in history
     assert "any change to the returns bumps the id's version" in " ".join(type(single).__doc__.split())
-    changelog = " ".join((Path(__file__).parents[1] / "CHANGELOG.md").read_text().split())
+    changelog = " ".join((Path(__file__).parents[2] / "CHANGELOG.md").read_text().split())
     unreleased = changelog[changelog.index("## [Unreleased]") :]
     fixed = unreleased[unreleased.index("### Fixed") :]
     assert "2026-12-03 (the burn relocation fix)" in fixed and "bumps the id's" in fixed

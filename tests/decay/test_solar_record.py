@@ -19,7 +19,7 @@ from orbit_env.decay.solar_record import (
     read_record,
 )
 
-DOCS_TABLE = Path(__file__).resolve().parent.parent / "docs" / "data" / "solar_daily_1995_2018.csv"
+DOCS_TABLE = Path(__file__).resolve().parents[2] / "docs" / "data" / "solar_daily_1995_2018.csv"
 
 
 def sw_line(date, f107_obs, ctr81, ap):

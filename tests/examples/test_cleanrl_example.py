@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "cleanrl_ppo.py"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "cleanrl_ppo.py"
 
 
 def test_cleanrl_example_trains_saves_and_prints_its_capture(tmp_path):

@@ -91,7 +91,7 @@ def test_register_envs_is_idempotent_and_uses_string_entry_points():
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_gymnasium_check_env_passes_without_warnings(env_id):
     # Without the render check: check_env would render in every mode, and "human" without a window
-    # warns (tests/test_render.py runs the full check headless; test_render_modes checks rgb_array and ansi).
+    # warns (tests/envs/test_render.py runs the full check headless; test_render_modes checks rgb_array and ansi).
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         check_env(make(env_id).unwrapped, skip_render_check=True)
@@ -879,7 +879,7 @@ def test_render_modes():
     nu = 16 * G0_M_S2 * 2.2 * 1.0 / 46.0
     assert perigee_km == pytest.approx(np.interp(nu, decay.nu, decay.perigee_m) / 1e3, abs=0.15)
     assert apogee_km == pytest.approx(np.interp(nu, decay.nu, decay.apogee_m) / 1e3, abs=1.35)
-    # render_mode="human" without a window: tests/test_render.py.
+    # render_mode="human" without a window: tests/envs/test_render.py.
 
 
 def test_missing_matplotlib_names_the_extra(monkeypatch):

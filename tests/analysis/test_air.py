@@ -12,7 +12,7 @@ from orbit_env.analysis.scenario import Scenario
 from orbit_env.cli import main
 from orbit_env.decay.solar import ConstantActivity
 
-PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "orbit_env"
+PACKAGE = pathlib.Path(__file__).resolve().parents[2] / "orbit_env"
 CUBESAT = ["--mass", "4", "--area", "0.03", "--cx", "2.2"]
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 from sgp4.api import Satrec
 
-DATA = Path(__file__).resolve().parents[1] / "benchmarks" / "data" / "reentry_tles"
+DATA = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "reentry_tles"
 UTC = dt.UTC
 MIN_BEFORE = dt.timedelta(days=7)
 MAX_BEFORE = dt.timedelta(days=3 * 365.25)

@@ -1,6 +1,6 @@
 """The continuous variant's yardstick (agents/plan.py): the DP's plans refined by a search, played open loop.
 
-On the DP tests' short task (tests/test_dp.py: 60 steps from low perigees, cheap
+On the DP tests' short task (tests/agents/test_dp.py: 60 steps from low perigees, cheap
 propellant), in the continuous variant, with the DP on burns 10 m/s apart.
 """
 
@@ -54,7 +54,7 @@ def test_the_plans_earn_at_least_the_dp_policy_and_are_followed(base):
     plan_returns, burns = play(policy)
     # The search keeps only gains over the DP's own plan, played from the state decoded from the
     # observation; the env plays it from its own state, which decode recovers up to the observation's
-    # float32 rounding (some 0.1 m of apogee, tests/test_task.py): 0.01 day is a wide allowance for it.
+    # float32 rounding (some 0.1 m of apogee, tests/envs/test_task.py): 0.01 day is a wide allowance for it.
     assert np.all(plan_returns >= dp_returns - 0.01), (plan_returns - dp_returns).min()
     assert plan_returns.mean() > dp_returns.mean() + 0.01, (plan_returns.mean(), dp_returns.mean())
     # Burns off the DP's 10 m/s sizes: the search refines them.

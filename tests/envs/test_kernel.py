@@ -8,10 +8,10 @@ agree at every step. Tolerance, and why: the loops call the C library's ``exp``,
 polynomials, within 1.2e-16 of the C library's: ``test_sine``), numpy its SIMD
 versions on arrays; the two may differ in the last bit (the same difference as the
 single environment's floats against the vector environment's, see
-``tests/test_envs.py``). A step's days are a difference of two W values up to 10^4
+``tests/envs/test_envs.py``). A step's days are a difference of two W values up to 10^4
 times larger, which amplifies a last-bit difference to about 1e-12 relative; the
 test allows 1e-10 relative on the float64 state and rewards (and 1e-9 day absolute on
-the rewards, as ``tests/test_envs.py``), and 1e-6 m on the heights' drops
+the rewards, as ``tests/envs/test_envs.py``), and 1e-6 m on the heights' drops
 over a step (differences of two heights of ~1e6 m, each good to 1e-12 relative). The float32 observations may
 round a value that sits on a float32 boundary either way: 1e-6 (16 ulps of float32).
 The cells of table B (which cell each orbit is in) and the episode ends must be equal.

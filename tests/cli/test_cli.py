@@ -293,7 +293,7 @@ def test_msis_version_00_is_nrlmsise00_and_shortens_the_life(capsys):
     v00 = json.loads(out)
     assert status == 0
     assert default["atmosphere"].startswith("NRLMSIS 2.1, ") and v00["atmosphere"].startswith("NRLMSISE-00, ")
-    # The life goes about as 1/density, and NRLMSISE-00 is 8-19% denser (tests/test_msis.py): 0.84-0.93,
+    # The life goes about as 1/density, and NRLMSISE-00 is 8-19% denser (tests/physics/test_msis.py): 0.84-0.93,
     # with margin for the profile's shape.
     assert 0.80 < v00["days"] / default["days"] < 0.95
     _, out, _ = run(capsys, *orbit, "--msis-version", "2.1", "--json")

@@ -114,7 +114,7 @@ def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():
 
 # ---- the command line on real element sets (benchmarks/data/reentry_tles, sources in its README)
 
-DATA = __import__("pathlib").Path(__file__).resolve().parent.parent / "benchmarks" / "data" / "reentry_tles"
+DATA = __import__("pathlib").Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "reentry_tles"
 
 
 def real_sets(norad, last, count):
