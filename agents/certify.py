@@ -31,10 +31,8 @@ replay's difference is reported), and the search runs from there on the missions
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -286,7 +284,7 @@ def _solar_optimum(
     are recorded as its plan, which the search then replays and perturbs in the env. The
     DPs are solved in ``workers`` processes (default: the cores, at most 8), as ``evaluate`` does.
     """
-    from orbit_env.agents.solar import starts
+    from orbit_env.agents.solar import map_missions, starts
     from orbit_env.envs import SOLAR_ENV_ID, solar_task
 
     probe = gymnasium.make(SOLAR_ENV_ID, **env_kwargs)
@@ -294,14 +292,8 @@ def _solar_optimum(
     probe.close()
     options = starts(task, episodes, seed)
     plans = _Plans(SOLAR_ENV_ID, options, env_kwargs)
-    jobs = [(task, {key: float(value[i]) for key, value in options.items()}) for i in range(episodes)]
     say(f"dp: {episodes} missions, one DP each")
-    count = workers or min(os.cpu_count() or 1, 8)
-    if count > 1 and episodes > 1:
-        with ProcessPoolExecutor(count) as pool:
-            solved = list(pool.map(_solar_plan, jobs))
-    else:
-        solved = [_solar_plan(job) for job in jobs]
+    solved = map_missions(task, options, _solar_plan, workers)
     returns, burns = np.zeros(episodes), np.zeros((episodes, plans.horizon))
     for i, (value, asked) in enumerate(solved):
         returns[i] = value

@@ -291,6 +291,26 @@ def hand_coded(task: SolarTask) -> dict[str, Never]:
 SOLAR_HAND_CODED = ("never", "all_at_once", "perigee_threshold", "life_threshold", "greedy_constant")
 
 
+def map_missions(
+    task: SolarTask,
+    options: Mapping[str, FloatArray],
+    solve: Callable[[tuple[SolarTask, dict[str, float]]], Any],
+    workers: int | None = None,
+) -> list[Any]:
+    """``solve((task, one mission's options))`` for every mission of ``options``, in order.
+
+    In ``workers`` processes (default: the cores, at most 8; 1: in this one): one DP a
+    mission is seconds of work, and its tables stay in the worker.
+    """
+    n = len(options["start_day"])
+    jobs = [(task, {key: float(value[i]) for key, value in options.items()}) for i in range(n)]
+    count = workers or min(os.cpu_count() or 1, 8)
+    if count > 1 and n > 1:
+        with ProcessPoolExecutor(count) as pool:
+            return list(pool.map(solve, jobs))
+    return [solve(job) for job in jobs]
+
+
 def _fly_dp(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, float, float, bool, bool, float]:
     """Solve one mission's DP and fly its policy (in a worker: the DP's tables stay there)."""
     from orbit_env.agents.solar_dp import SolarDP
@@ -348,13 +368,7 @@ def evaluate_solar(
     estimate = np.full(episodes, np.nan)
     if include_dp:
         say(f"dp ({episodes} missions, one DP each)")
-        jobs = [(task, {k: float(v[i]) for k, v in options.items()}) for i in range(episodes)]
-        count = workers or min(os.cpu_count() or 1, 8)
-        if count > 1 and episodes > 1:
-            with ProcessPoolExecutor(count) as pool:
-                rows = list(pool.map(_fly_dp, jobs))
-        else:
-            rows = [_fly_dp(job) for job in jobs]
+        rows = map_missions(task, options, _fly_dp, workers)
         columns = list(zip(*rows, strict=True))
         flown["dp"] = Flown(
             np.array(columns[0]),
