@@ -15,11 +15,15 @@ is the docstring of `OrbitRaisingEnv` (of `OrbitRaisingSolarEnv` for the solar t
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import gymnasium
 
 from orbit_env.envs.config import UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
-from orbit_env.envs.orbit_raising import OrbitRaisingEnv
-from orbit_env.envs.solar import OrbitRaisingSolarEnv
+
+if TYPE_CHECKING:
+    from orbit_env.envs.orbit_raising import OrbitRaisingEnv
+    from orbit_env.envs.solar import OrbitRaisingSolarEnv
 
 __all__ = [
     "ENV_IDS",
@@ -65,3 +69,20 @@ def register_envs() -> None:
             vector_entry_point=vector_entry_point,
             kwargs=dict(_VARIANTS.get(env_id, {})),
         )
+
+
+def __getattr__(name: str) -> Any:
+    """The environment classes, imported when first asked for: registering the ids needs only their names.
+
+    ``import orbit_env`` registers the ids for a command that decays one orbit as well; the
+    classes (and the task models, the compiled kernels' modules) load on ``gymnasium.make``.
+    """
+    if name == "OrbitRaisingEnv":
+        from orbit_env.envs.orbit_raising import OrbitRaisingEnv
+
+        return OrbitRaisingEnv
+    if name == "OrbitRaisingSolarEnv":
+        from orbit_env.envs.solar import OrbitRaisingSolarEnv
+
+        return OrbitRaisingSolarEnv
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
