@@ -51,3 +51,20 @@ def test_curves_refuse_unknown_algorithms_and_counts(tmp_path):
         curves("OrbitRaising-v0", ["dqn"], 1, 1, 1, tmp_path)
     with pytest.raises(ValueError, match=">= 1"):
         curves("OrbitRaising-v0", ["ppo"], 0, 1, 1, tmp_path)
+
+
+def test_the_shipped_curves_are_the_statistics_of_their_runs():
+    from importlib import resources
+
+    folder = resources.files("orbit_env.agents").joinpath("baselines", "curves")
+    names = sorted(p.name for p in folder.iterdir() if p.name.endswith(".json"))
+    assert "OrbitRaising-v0.json" in names
+    for name in names:
+        result = json.loads(folder.joinpath(name).read_text())
+        assert result["env"] + ".json" == name
+        assert {run["algo"] for run in result["runs"]} == set(result["curves"]) == {"ppo", "ppo_recipe"}
+        assert sorted(run["seed"] for run in result["runs"] if run["algo"] == "ppo") == [0, 1, 2, 3, 4]
+        for run in result["runs"]:
+            steps = [point[0] for point in run["points"]]
+            assert steps[0] == 0 and steps == sorted(steps) and steps[-1] >= result["timesteps"]
+        assert aggregate(result["runs"]) == result["curves"]  # the curves are their runs' IQM and intervals
