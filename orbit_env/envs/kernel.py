@@ -73,8 +73,9 @@ class KernelParameters(NamedTuple):
 
 
 # The places of the state's rows, the task's numbers and a grid's scales in the arrays the loops
-# read, each from its one declaration. Module constants: numba freezes them into the machine code.
-_P = KernelParameters(*range(len(KernelParameters._fields)))
+# read, each from its one declaration (`PARAMETERS` also the solar task's loops'). Module constants:
+# numba freezes them into the machine code.
+PARAMETERS = KernelParameters(*range(len(KernelParameters._fields)))
 _G = GridScales(*range(len(GridScales._fields)))
 
 
@@ -167,9 +168,9 @@ def _apogee_after_m(perigee_m: float, apogee_m: float, dv_m_s: float) -> float:
 def _update_density(data: FloatArray, k: int, p: FloatArray) -> None:
     """`task.update_density` of row ``k``."""
     scale = data[ROW.density_base, k]
-    if p[_P.density_varies] != 0.0:
-        angle = TWO_PI * data[ROW.time_days, k] / p[_P.cycle_period_days] + data[ROW.density_phase_rad, k]
-        scale = scale * math.exp(p[_P.cycle_amplitude] * math.sin(angle))
+    if p[PARAMETERS.density_varies] != 0.0:
+        angle = TWO_PI * data[ROW.time_days, k] / p[PARAMETERS.cycle_period_days] + data[ROW.density_phase_rad, k]
+        scale = scale * math.exp(p[PARAMETERS.cycle_amplitude] * math.sin(angle))
     _set_density_scale(data, k, scale)
 
 
@@ -207,7 +208,8 @@ def burn_row(
     mass = dry if dv >= dv_fuel else max(mass / math.exp(dv / exhaust), dry)
     data[ROW.mass_kg, k] = mass
     data[ROW.dv_left_m_s, k] = max(exhaust * math.log(mass / dry), 0.0)
-    data[ROW.nominal_w_per_day, k] = G0_M_S2 * (data[ROW.drag_area_m2, k] / mass * p[_P.nominal_scale_s_per_day])
+    nominal_scale_s_per_day = p[PARAMETERS.nominal_scale_s_per_day]
+    data[ROW.nominal_w_per_day, k] = G0_M_S2 * (data[ROW.drag_area_m2, k] / mass * nominal_scale_s_per_day)
     _update_density(data, k, p)
     _relocate(data, k, min(apogee_after, CURVES_MAX_APOGEE_M), a_cells, a_grid, b_cells, b_grid)
     return dv
@@ -262,7 +264,7 @@ def _sine(x: float) -> float:
 def _modulation_exponents(time_days: FloatArray, phase_rad: FloatArray, p: FloatArray, out: FloatArray) -> None:
     """A sin(2 pi t / T + phi) of every satellite: the exponent of `task.density_scale_at`."""
     # Locals, not reads of p in the loop: ``out`` could alias p, which would keep the loop scalar.
-    amplitude, period_days = p[_P.cycle_amplitude], p[_P.cycle_period_days]
+    amplitude, period_days = p[PARAMETERS.cycle_amplitude], p[PARAMETERS.cycle_period_days]
     beyond = 0  # an integer count: a float reduction would not vectorize without fast-math
     for k in range(time_days.size):
         angle = TWO_PI * time_days[k] / period_days + phase_rad[k]
@@ -279,9 +281,9 @@ def _coast_start(data: FloatArray, p: FloatArray, modulation: FloatArray, nu_aft
     ``x`` gets nu / NU_REF, whose log1p is the new tau (`UniversalCurves._after`).
     """
     for k in range(data.shape[1]):
-        if p[_P.density_varies] != 0.0:
+        if p[PARAMETERS.density_varies] != 0.0:
             _set_density_scale(data, k, data[ROW.density_base, k] * modulation[k])
-        nu = max(data[ROW.nu, k] - p[_P.revolutions_per_step] * data[ROW.nu_per_rev, k], 0.0)
+        nu = max(data[ROW.nu, k] - p[PARAMETERS.revolutions_per_step] * data[ROW.nu_per_rev, k], 0.0)
         nu_after[k] = nu
         x[k] = nu * (1.0 / NU_REF)
 
@@ -338,18 +340,19 @@ def _coast_finish(
         data[ROW.time_days, k] += days
         steps = data[ROW.steps, k] + 1.0
         data[ROW.steps, k] = steps
-        reward[k] = days - p[_P.propellant_cost_per_m_s] * made[k] if p[_P.propellant_cost_per_m_s] != 0.0 else days
+        cost = p[PARAMETERS.propellant_cost_per_m_s]
+        reward[k] = days - cost * made[k] if cost != 0.0 else days
         terminated[k] = data[ROW.tau, k] <= 0.0
-        truncated[k] = steps >= p[_P.horizon_steps]
+        truncated[k] = steps >= p[PARAMETERS.horizon_steps]
         # `task.observation` (a batch's clock is not clamped, as in `task.observe`).
         life = period * nu / data[ROW.nominal_w_per_day, k]
-        obs[k, 0] = hp * p[_P.per_height_scale_m]
-        obs[k, 1] = apogee * p[_P.per_height_scale_m]
-        obs[k, 2] = data[ROW.dv_left_m_s, k] * p[_P.per_dv_scale_m_s]
-        obs[k, 3] = steps * (1.0 / p[_P.horizon_steps])
-        obs[k, 4] = life / (life + p[_P.lifetime_scale_days])
-        obs[k, 5] = apogee_drop / (apogee_drop + p[_P.apogee_drop_scale_m])
-        obs[k, 6] = perigee_drop / (perigee_drop + p[_P.perigee_drop_scale_m])
+        obs[k, 0] = hp * p[PARAMETERS.per_height_scale_m]
+        obs[k, 1] = apogee * p[PARAMETERS.per_height_scale_m]
+        obs[k, 2] = data[ROW.dv_left_m_s, k] * p[PARAMETERS.per_dv_scale_m_s]
+        obs[k, 3] = steps * (1.0 / p[PARAMETERS.horizon_steps])
+        obs[k, 4] = life / (life + p[PARAMETERS.lifetime_scale_days])
+        obs[k, 5] = apogee_drop / (apogee_drop + p[PARAMETERS.apogee_drop_scale_m])
+        obs[k, 6] = perigee_drop / (perigee_drop + p[PARAMETERS.perigee_drop_scale_m])
 
 
 class _Kernels(NamedTuple):
@@ -448,7 +451,7 @@ def coast_and_observe(
     n = state_data.shape[1]
     _, _, b_cells, b_grid = tables(curves)
     first, second = np.empty(n), np.empty(n)
-    if parameters[_P.density_varies] != 0.0:
+    if parameters[PARAMETERS.density_varies] != 0.0:
         kernels.modulation_exponents(state_data[ROW.time_days], state_data[ROW.density_phase_rad], parameters, first)
         np.exp(first, out=first)
     nu_after = np.empty(n)

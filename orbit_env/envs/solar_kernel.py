@@ -33,14 +33,12 @@ from numpy.typing import NDArray
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY, TWO_PI
 from orbit_env.decay.curves import NU_REF
 from orbit_env.decay.drag_clock import DragClock, drag_days_at
-from orbit_env.envs.kernel import JIT_VARIABLE, KernelParameters, burn_row, cell, table_a_point, tables
+from orbit_env.envs.kernel import JIT_VARIABLE, PARAMETERS, burn_row, cell, table_a_point, tables
 from orbit_env.envs.kernel import compiled as kernel_loops
 from orbit_env.envs.state import ROW, SEGMENT_ROW, STALE_SEGMENT
 
 FloatArray = NDArray[np.float64]
 
-# The places of the task's numbers in the array the loops read (`orbit_env.envs.kernel.KernelParameters`).
-_P = KernelParameters(*range(len(KernelParameters._fields)))
 #: The lowest rate W may fall at when the rule's years end with the orbit still up (per day, relative).
 MIN_RATE = 1e-9
 
@@ -355,7 +353,7 @@ def _step_rows(
     The burn is `orbit_env.envs.kernel.burn_row` (the known-density task's); the reward is the
     days lived less the propellant's cost; the ends are re-entry and the horizon's step.
     """
-    cost, horizon = p[_P.propellant_cost_per_m_s], p[_P.horizon_steps]
+    cost, horizon = p[PARAMETERS.propellant_cost_per_m_s], p[PARAMETERS.horizon_steps]
     for k in range(data.shape[1]):
         dv = 0.0
         if min(requested_m_s[k], data[ROW.dv_left_m_s, k]) > 0.0:
@@ -409,13 +407,13 @@ def _observe_rows(
         apogee_drop = max(data[ROW.apogee_drop_m, k], 0.0)
         perigee_drop = max(data[ROW.perigee_drop_m, k], 0.0)
         values = (
-            data[ROW.perigee_m, k] * p[_P.per_height_scale_m],
-            data[ROW.apogee_m, k] * p[_P.per_height_scale_m],
-            data[ROW.dv_left_m_s, k] * p[_P.per_dv_scale_m_s],
-            min(steps / p[_P.horizon_steps], 1.0),
-            life / (life + p[_P.lifetime_scale_days]),
-            apogee_drop / (apogee_drop + p[_P.apogee_drop_scale_m]),
-            perigee_drop / (perigee_drop + p[_P.perigee_drop_scale_m]),
+            data[ROW.perigee_m, k] * p[PARAMETERS.per_height_scale_m],
+            data[ROW.apogee_m, k] * p[PARAMETERS.per_height_scale_m],
+            data[ROW.dv_left_m_s, k] * p[PARAMETERS.per_dv_scale_m_s],
+            min(steps / p[PARAMETERS.horizon_steps], 1.0),
+            life / (life + p[PARAMETERS.lifetime_scale_days]),
+            apogee_drop / (apogee_drop + p[PARAMETERS.apogee_drop_scale_m]),
+            perigee_drop / (perigee_drop + p[PARAMETERS.perigee_drop_scale_m]),
             indices[0, yesterday] / index_scale,
             indices[1, yesterday] / index_scale,
             indices[2, yesterday] / index_scale,

@@ -87,7 +87,7 @@ def test_every_kernel_parameter_is_the_tasks(name: str) -> None:
     assert parameters.dtype == np.float64 and parameters.shape == (len(KernelParameters._fields),)
     assert KernelParameters(*parameters.tolist())._asdict() == expected
     for field, value in expected.items():  # at the index the loops read it from
-        assert parameters[getattr(kernel_module._P, field)] == value, field
+        assert parameters[getattr(kernel_module.PARAMETERS, field)] == value, field
 
 
 def test_every_grid_scale_is_the_grids() -> None:
