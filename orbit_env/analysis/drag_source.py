@@ -211,16 +211,15 @@ def shape_drag_coefficient(
     }
 
 
-def drag_sigma_of(source: str) -> float | None:
-    """The drag parameter's log-normal sigma by its source (None: the default, a known satellite's C_D)."""
-    return ONE_SET_DRAG_SIGMA if source in (SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, SOURCE_BSTAR) else None
-
-
 def drag_sigma(source: DragSource) -> float | None:
-    """The drag parameter's log-normal sigma: a history's from its fit, one set's measured, else the default."""
+    """The drag parameter's log-normal sigma: a history's from its fit, one set's measured, else None.
+
+    None: the uncertainty's default, a known satellite's drag coefficient.
+    """
     if "drag_fit" in source.report:
         return float(source.report["drag_fit"]["sigma_ln"])
-    return drag_sigma_of(source.source)
+    one_set = (SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, SOURCE_BSTAR)
+    return ONE_SET_DRAG_SIGMA if source.source in one_set else None
 
 
 def element_set_orbits(
