@@ -1,7 +1,7 @@
 """Side by side: orbit_env's dated lifetimes against satkit's numerical propagator (issue 27, item 4).
 
     pip install -e ".[bench]"       # satkit and satkit-data (benchmark only)
-    python benchmarks/bench_satkit.py [--cases NAME ...] [--same-indices]
+    python benchmarks/bench_satkit.py [--cases NAME ...] [--same-indices] [--daily-ap]
 
 Both sides start from the same element set and run the same density model:
 
@@ -21,13 +21,16 @@ Both sides start from the same element set and run the same density model:
 * **orbit_env**: ``orbit-env lifetime --tle FILE --mass 4 --area 0.03 --cx 2.2
   --msis-version 00`` (the set's epoch, the shipped record, co-rotating air, the orbit
   flown: the mean elements plus J2's offset; ``--node-local-time`` for the Sun-synchronous
-  case), timed as a whole command (a new process, disk cache warm) and in process
+  case; on storm days NRLMSIS's storm-time mode with the record's 3-hourly ap, the default),
+  timed as a whole command (a new process, disk cache warm) and in process
   (`orbit_env.lifetime` called as the command calls it, a second time in the same process).
 
 The table also gives satkit's radius averaged over its first revolutions beside
 orbit_env's flown mean radius a (1 + e^2/2): the two start on the same orbit.
-``--same-indices`` (a diagnostic) runs satkit on the indices orbit_env takes: the daily Ap
-for the 3-hourly ap, no radio bursts. Times are wall-clock on a shared machine: read the
+``--same-indices`` (a diagnostic) runs both on the same indices: satkit on the daily Ap for
+the 3-hourly ap and no radio bursts, orbit_env with ``--daily-ap`` (the daily Ap on storm
+days too). ``--daily-ap`` alone runs orbit_env so against satkit's 3-hourly ap (orbit_env
+before the storm-time mode). Times are wall-clock on a shared machine: read the
 speed as the ratio within one run.
 """
 
@@ -270,18 +273,23 @@ def satkit_start_height_km(lines: list[str]) -> float:
     return (float(np.mean(radii)) - EQUATORIAL_RADIUS_M) / 1e3
 
 
-def orbit_env_options(case: Case, path: str) -> list[str]:
+def orbit_env_options(case: Case, path: str, daily_ap: bool = False) -> list[str]:
     """The command's options (the set's epoch and inclination are read from it)."""
     options = ["--tle", path, "--mass", str(MASS_KG), "--area", str(AREA_M2), "--cx", str(CX), "--msis-version", "00"]
     if case.node_local_time_h is not None:
         options += ["--node-local-time", str(case.node_local_time_h)]
-    return options
+    return [*options, "--daily-ap"] if daily_ap else options
 
 
-def orbit_env_in_process(case: Case, elements: ElementSet) -> tuple[float, float]:
+def orbit_env_in_process(case: Case, elements: ElementSet, daily_ap: bool = False) -> tuple[float, float]:
     """`orbit_env.lifetime` as the command calls it; its days and the time of a second call [s]."""
     assert elements.epoch_iso is not None
-    options = {"epoch": elements.epoch_iso.rstrip("Z"), "msis_version": "00", "node_local_time": case.node_local_time_h}
+    options = {
+        "epoch": elements.epoch_iso.rstrip("Z"),
+        "msis_version": "00",
+        "node_local_time": case.node_local_time_h,
+        "daily_ap": daily_ap,
+    }
     air = Scenario(MsisAir.from_options(options)).in_sphere_heights("equatorial", elements.inclination_deg)
     offset = offset_km("equatorial")
     satellite = Satellite(drag_coefficient=CX, mass_kg=MASS_KG, area_m2=AREA_M2)
@@ -301,11 +309,11 @@ def orbit_env_in_process(case: Case, elements: ElementSet) -> tuple[float, float
     return days, time.perf_counter() - start
 
 
-def orbit_env_command(case: Case, path: str) -> tuple[float, float]:
+def orbit_env_command(case: Case, path: str, daily_ap: bool = False) -> tuple[float, float]:
     """The whole command in a new process (run once before, so the disk cache is warm): days and wall time [s]."""
     exe = shutil.which("orbit-env")
     command = [exe] if exe else [sys.executable, "-m", "orbit_env.cli"]
-    command += ["lifetime", *orbit_env_options(case, path), "--json"]
+    command += ["lifetime", *orbit_env_options(case, path, daily_ap), "--json"]
     subprocess.run(command, check=True, capture_output=True)
     start = time.perf_counter()
     out = subprocess.run(command, check=True, capture_output=True, text=True).stdout
@@ -328,13 +336,13 @@ class Row:
         return self.orbit_env_days / self.satkit_days
 
 
-def run_case(case: Case, folder: str) -> Row:
-    """Both sides on one case, one after the other (never in parallel)."""
+def run_case(case: Case, folder: str, daily_ap: bool = False) -> Row:
+    """Both sides on one case, one after the other (never in parallel); ``daily_ap``: orbit_env with ``--daily-ap``."""
     lines, elements = element_set(case)
     path = os.path.join(folder, case.name + ".tle")
     Path(path).write_text("\n".join(lines) + "\n")
-    command_days, command_s = orbit_env_command(case, path)
-    days, in_process_s = orbit_env_in_process(case, elements)
+    command_days, command_s = orbit_env_command(case, path, daily_ap)
+    days, in_process_s = orbit_env_in_process(case, elements, daily_ap)
     if abs(days - command_days) > 1e-6 * days:
         raise RuntimeError(f"{case.name}: the in-process call gives {days} days, the command {command_days}")
     satkit_days, satkit_s = satkit_lifetime(lines)
@@ -376,15 +384,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--same-indices",
         action="store_true",
-        help="diagnostic: satkit on orbit_env's indices (daily Ap for the 3-hourly ap, no radio bursts)",
+        help="diagnostic: both on the same indices (satkit on the daily Ap, no radio bursts; orbit_env --daily-ap)",
     )
+    parser.add_argument("--daily-ap", action="store_true", help="orbit_env with --daily-ap (the daily Ap every day)")
     args = parser.parse_args(argv)
     chosen = [c for c in CASES if not args.cases or c.name in args.cases]
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         use_shipped_data(folder, args.same_indices)
         for case in chosen:
-            row = run_case(case, folder)
+            row = run_case(case, folder, args.daily_ap or args.same_indices)
             rows.append(row)
             print(f"{case.name}: satkit {row.satkit_days:.2f} d, orbit_env {row.orbit_env_days:.2f} d", flush=True)
     print(table(rows))

@@ -96,6 +96,11 @@ class ScaledForecast:
         low, high = F107_RANGE_SFU
         return np.clip(f107 * k, low, high), np.clip(f107a * k, low, high), ap
 
+    def ap_history(self, days: ArrayLike) -> FloatArray:
+        """The activity's 3-hourly ap, not scaled (NaN if it has none): its storm days stay storm days."""
+        inner = getattr(self.activity, "ap_history", None)
+        return np.full((np.size(days), 27), np.nan) if inner is None else inner(days)
+
     def describe(self) -> str:
         """One line."""
         inner = self.activity.describe() if hasattr(self.activity, "describe") else type(self.activity).__name__

@@ -354,6 +354,12 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
         choices=tuple(MSIS_VERSION_CHOICES),
         help="msis: NRLMSIS version (default 2.1; 00 = NRLMSISE-00)",
     )
+    group.add_argument(
+        "--daily-ap",
+        action="store_true",
+        help="msis with --epoch: the daily Ap every day (default: storm days, any 3-hourly ap >= 48 in the day "
+        "or the 57 h before, take NRLMSIS's storm-time mode with the record's 3-hourly ap)",
+    )
     group.add_argument("--node-local-time", type=number, metavar="HOURS", help="msis: Sun-synchronous node local time")
     group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")
     group.add_argument(

@@ -47,6 +47,7 @@ from orbit_env.decay.density_multiplier import (
     life_rate_ratio,
     log_density_slope_per_m,
     orbit_ratio,
+    uniform_gradient,
 )
 from orbit_env.decay.solar import SolarActivity, day_of_year
 from orbit_env.physics.atmosphere.msis import (
@@ -98,7 +99,13 @@ SPREAD_REFRESH_M = 5e3
 #: (`orbit_env.decay.daily_air`): one NRLMSIS call of half a year instead of one per chunk.
 PREFETCH_DAYS = 180
 
-DailyIndices = tuple[tuple[float, float, float, float], ...]
+#: A day counts as a storm day, and takes NRLMSIS's storm-time mode (3-hourly ap history), when the largest
+#: of the 27 3-hourly ap that mode reads on it (57 h before its first slot to its last) reaches this; the
+#: other days keep the daily Ap. Needs a record with the 3-hourly ap (`RecordActivity.ap_history`).
+#: Measured: docs/validation-modern/solar-activity.md, section "Storm days".
+STORM_AP = 48.0
+
+DailyIndices = tuple[tuple[float, ...], ...]
 
 
 @lru_cache(maxsize=64)
@@ -192,6 +199,9 @@ class SolarDecayModel:
         max_years: Stop propagating after this long.
         version: NRLMSIS version of every profile and ratio (see
             `orbit_env.physics.atmosphere.msis.MSIS_VERSIONS`; 0.0 is NRLMSISE-00).
+        storm_ap: On storm days (`STORM_AP`) of an activity that has the 3-hourly ap
+            (``activity.ap_history``, the CelesTrak record's), NRLMSIS in its storm-time mode
+            (`daily_indices`); False: the daily Ap every day.
     """
 
     activity: SolarActivity
@@ -206,6 +216,7 @@ class SolarDecayModel:
     near_circular_bins: bool = True
     max_years: float = DEFAULT_MAX_YEARS
     version: float = DEFAULT_MSIS_VERSION
+    storm_ap: bool = True
     _bins: dict[tuple[float, float], DecayModel] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -243,6 +254,8 @@ class SolarDecayModel:
         """(F10.7, 81-day mean, Ap, day of the year) at each of ``days`` (Unix days), rounded for the caches.
 
         Without ``follow_season`` each day is `SEASON_NODES` entries, one per node of the year.
+        A storm day (``storm_ap``, `STORM_AP`) adds the 27 3-hourly ap of its storm-time history
+        (`orbit_env.decay.daily_air`): its air is NRLMSIS's storm-time mode through the day.
         """
         f107, f107a, ap = self.activity.indices(days)
         if self.follow_season:
@@ -253,10 +266,33 @@ class SolarDecayModel:
         # Rounded so that repeated runs (bisections, batches) hit the cache: 0.1 sfu and 0.1 Ap
         # move the density by less than 0.1%.
         columns = (np.round(f107, 1), np.round(f107a, 1), np.round(ap, 1), doy)
+        per_day = 1
         if not self.follow_season:
             nodes = (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
             columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(nodes, days.size))
-        return tuple(zip(*(c.tolist() for c in columns), strict=True))
+            per_day = SEASON_NODES
+        keys = tuple(zip(*(c.tolist() for c in columns), strict=True))
+        history = self.storm_history(days)
+        if history is None:
+            return keys
+        history = np.repeat(history, per_day, axis=0)
+        return tuple(key if np.isnan(row[0]) else (*key, *row.tolist()) for key, row in zip(keys, history, strict=True))
+
+    def storm_history(self, days: ArrayLike) -> FloatArray | None:
+        """Each storm day's 27 3-hourly ap (``activity.ap_history``), NaN on the other days: shape (days, 27).
+
+        A storm day: all 27 known and the largest at least `STORM_AP`. None: no storm day
+        among ``days`` (or ``storm_ap`` off, or an activity without 3-hourly ap).
+        """
+        ap_history = getattr(self.activity, "ap_history", None) if self.storm_ap else None
+        if ap_history is None:
+            return None
+        history = np.asarray(ap_history(np.atleast_1d(np.asarray(days, dtype=np.float64))), dtype=np.float64)
+        storm = np.all(np.isfinite(history), axis=1) & (np.max(history, axis=1) >= STORM_AP)
+        if not storm.any():
+            return None
+        history[~storm] = np.nan
+        return history
 
     def prefetch(self, daily: DailyIndices, t_days: float) -> None:
         """Make sure the air table holds ``daily``; if not, it also computes the `PREFETCH_DAYS` from ``t_days``."""
@@ -349,7 +385,7 @@ class SolarDecayModel:
                 return ratio
         table = log_ratio[None, :] if offsets is None else log_ratio[None, :] + offsets
         at_perigee = np.exp(interpolate_rows(table, RATIO_GRID_M, perigee_m))
-        ratio_slope = interpolate_rows(np.gradient(table, RATIO_GRID_M, axis=1), RATIO_GRID_M, perigee_m)
+        ratio_slope = interpolate_rows(uniform_gradient(table, RATIO_GRID_M), RATIO_GRID_M, perigee_m)
         atmosphere = self.bin_model(binned).atmosphere
         assert isinstance(atmosphere, MsisAtmosphere)
         density_slope = np.interp(perigee_m, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
@@ -466,6 +502,8 @@ def _daily_steps(
     n = label.size
     days = np.full(n, np.nan)
     nu, hp, ha = nu.copy(), hp.copy(), ha.copy()
+    # W left at each satellite's nu, kept from the lookup that gave its heights (the next step starts there).
+    w_left = curves.weighted_at(label, nu)[2]
 
     def rates(which: NDArray[np.intp], start: float, length: float) -> tuple[FloatArray, FloatArray]:
         """W left and dW/dt of ``which`` in the step from ``start`` (days) of ``length`` days."""
@@ -483,8 +521,7 @@ def _daily_steps(
             offsets=None if offsets is None else offsets[which],
             inclination_deg=None if inclination_deg is None else inclination_deg[which],
         )
-        _, _, w0 = curves.weighted_at(label[which], nu[which])
-        return w0, gcs[which] * ratio
+        return w_left[which], gcs[which] * ratio
 
     def move(which: NDArray[np.intp], start: float, length: float, w0: FloatArray, rate: FloatArray) -> None:
         target = w0 - rate * length * SECONDS_PER_DAY
@@ -493,7 +530,7 @@ def _daily_steps(
         going = which[~ended]
         if going.size:
             nu[going] = curves.nu_at_weight(label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
-            hp[going], ha[going], _ = curves.weighted_at(label[going], nu[going])
+            hp[going], ha[going], w_left[going] = curves.weighted_at(label[going], nu[going])
         if ended.any():
             nu[which[ended]] = 0.0
             hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))

@@ -19,6 +19,14 @@ only for days it has never seen. (Written at every growth, the uncertainty's sam
 whose scaled forecasts are days never seen, rewrote a growing table hundreds of times.)
 The rows are NRLMSIS's own values for those indices (a memo, not an interpolation), so
 results do not change with what is cached. Units: SI (m, kg/m^3).
+
+**Storm days.** A day the decay counts as a storm day (`orbit_env.decay.chunked.STORM_AP`)
+has a longer key: its four indices, then the 27 3-hourly ap NRLMSIS's storm-time mode
+reads on it (`orbit_env.decay.solar_record.RecordActivity.ap_history`). Its row is NRLMSIS
+in that mode at each of the day's eight 3-hour slots, each with its own ap history
+(`orbit_env.physics.atmosphere.msis.ap_histories`), averaged over the slots as well as the
+orbit. The key holds all the row depends on, so a storm row is never another day's, nor a
+daily-Ap row (a key of four); the table stores the keys padded with NaN to one width.
 """
 
 from __future__ import annotations
@@ -32,11 +40,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env import cache
-from orbit_env.physics.atmosphere.msis import orbit_mean_density_by_day_kg_m3
+from orbit_env.physics.atmosphere.msis import ap_histories, orbit_mean_density_by_day_kg_m3
 
 FloatArray = NDArray[np.float64]
-#: A day's indices as the decay rounds them: (F10.7 [sfu], 81-day mean [sfu], Ap, day of the year 1-366).
-DayKey = tuple[float, float, float, float]
+#: A day's indices as the decay rounds them: (F10.7 [sfu], 81-day mean [sfu], Ap, day of the year 1-366), then
+#: on a storm day the 27 3-hourly ap of its storm-time history (the module docstring).
+DayKey = tuple[float, ...]
+#: Length of a daily-Ap day's key; a storm day's is `DAILY_KEY` + `STORM_AP_SLOTS`.
+DAILY_KEY = 4
+#: The 3-hourly ap a storm day's key holds: 57 h before its first slot to its last.
+STORM_AP_SLOTS = 27
 #: A table is written again when it holds this many times the rows it held when last written (or read).
 STORE_GROWTH = 1.25
 _TABLES: weakref.WeakSet[DailyAirTable] = weakref.WeakSet()
@@ -85,7 +98,7 @@ class DailyAirTable:
             self._log_rho = np.empty((0, self.heights_m.size))
         else:
             self._keys, self._log_rho = stored["keys"], stored["log_density"]
-        self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(tuple, self._keys.tolist()))}
+        self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(_unpadded, self._keys.tolist()))}
         self._stored_rows = len(self._row_of)
         _TABLES.add(self)
 
@@ -110,21 +123,35 @@ class DailyAirTable:
 
     def _add(self, keys: Sequence[DayKey]) -> None:
         new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
-        f107, f107a, ap, doy = np.array(new, dtype=np.float64).T
-        rho = orbit_mean_density_by_day_kg_m3(
-            self.heights_m,
-            f107,
-            f107a,
-            ap,
-            doy,
-            self.inclination_deg,
-            self.ascending_node_local_time_h,
-            latitude_nodes=self.latitude_nodes,
-            local_time_nodes=self.local_time_nodes,
-            version=self.version,
-        )
+        # Daily-Ap days in one NRLMSIS call, storm days (longer keys) in another.
+        new.sort(key=len)
+        daily = sum(len(key) == DAILY_KEY for key in new)
+        rho = np.empty((len(new), self.heights_m.size))
+        for part, storm in ((slice(0, daily), False), (slice(daily, None), True)):
+            if not new[part]:
+                continue
+            values = np.array(new[part], dtype=np.float64)
+            f107, f107a, ap, doy = values[:, :DAILY_KEY].T
+            rho[part] = orbit_mean_density_by_day_kg_m3(
+                self.heights_m,
+                f107,
+                f107a,
+                ap,
+                doy,
+                self.inclination_deg,
+                self.ascending_node_local_time_h,
+                latitude_nodes=self.latitude_nodes,
+                local_time_nodes=self.local_time_nodes,
+                version=self.version,
+                ap_history=ap_histories(ap, values[:, DAILY_KEY:]) if storm else None,
+            )
         start = len(self._row_of)
-        self._keys = np.concatenate([self._keys, np.array(new, dtype=np.float64)])
+        width = max(self._keys.shape[1], max(map(len, new)))
+        added = np.full((len(new), width), np.nan)
+        for row, key in enumerate(new):
+            added[row, : len(key)] = key
+        held = np.pad(self._keys, ((0, 0), (0, width - self._keys.shape[1])), constant_values=np.nan)
+        self._keys = np.concatenate([held, added])
         self._log_rho = np.concatenate([self._log_rho, np.log(rho)])
         self._row_of.update({key: start + k for k, key in enumerate(new)})
         if len(self) >= STORE_GROWTH * self._stored_rows:
@@ -137,6 +164,12 @@ class DailyAirTable:
             arrays = {"keys": self._keys, "log_density": self._log_rho}
             cache.store("airdays", self._description, arrays, compress=False)
             self._stored_rows = len(self)
+
+
+def _unpadded(stored: list[float]) -> DayKey:
+    """A key as the table stores it (NaN-padded to the widest key) back to its own length."""
+    key = tuple(stored)
+    return key if len(key) == DAILY_KEY or not np.isnan(key[DAILY_KEY]) else key[:DAILY_KEY]
 
 
 @atexit.register

@@ -72,6 +72,7 @@ class DragClock:
             float(self.inclination_deg),
             rotating_atmosphere=True,
             version=self.version,
+            storm_ap=False,  # the task's air as its baselines were measured in: the daily Ap every day
         )
 
     @cached_property

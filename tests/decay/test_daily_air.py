@@ -8,20 +8,23 @@ of days against one day; exp of the stored logarithm) differ in the last bits on
 """
 
 import numpy as np
+import pymsis
 import pytest
 
 from orbit_env import cache
 from orbit_env.decay import daily_air
-from orbit_env.decay.chunked import SolarDecayModel, air_table
+from orbit_env.decay.chunked import STORM_AP, SolarDecayModel, air_table
 from orbit_env.decay.daily_air import DailyAirTable
 from orbit_env.decay.density_multiplier import RATIO_GRID_M, RATIO_NODES
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import load_record
 from orbit_env.physics.atmosphere.msis import (
     SEASON_NODES,
+    geodetic_altitude_m,
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
     orbit_mean_density_by_day_kg_m3,
+    orbit_samples,
 )
 
 HEIGHTS_M = np.array([200e3, 400e3, 700e3])
@@ -81,14 +84,18 @@ def test_without_a_disk_cache_the_table_works_in_memory(monkeypatch):
     np.testing.assert_allclose(np.exp(rows[1]), direct(KEYS[1]), rtol=RTOL)
 
 
-@pytest.mark.parametrize("follow_season", [True, False])
-def test_the_decays_density_ratio_equals_nrlmsis_directly(follow_season):
+@pytest.mark.parametrize(("follow_season", "storm_ap"), [(True, False), (False, False), (True, True), (False, True)])
+def test_the_decays_density_ratio_equals_nrlmsis_directly(follow_season, storm_ap):
     start = unix_days("2015-03-10")  # the March 2015 storm: indices that change day by day
-    model = SolarDecayModel(load_record(), start, 51.6, follow_season=follow_season)
+    model = SolarDecayModel(load_record(), start, 51.6, follow_season=follow_season, storm_ap=storm_ap)
     daily = model.daily_indices(start + np.arange(20.0))
+    assert any(len(key) > 4 for key in daily) == storm_ap
     binned = (130.0, 12.0)
-    f107, f107a, ap, doy = (np.array(c) for c in zip(*daily, strict=True))
-    exact = mean_density_over_days_kg_m3(RATIO_GRID_M, f107, f107a, ap, doy, 51.6, None, **RATIO_NODES)
+    if storm_ap:  # each row on its own: the storm days' in NRLMSIS's storm-time mode
+        exact = np.mean([direct_row(key, RATIO_GRID_M, 51.6, **RATIO_NODES) for key in daily], axis=0)
+    else:
+        f107, f107a, ap, doy = (np.array(c) for c in zip(*daily, strict=True))
+        exact = mean_density_over_days_kg_m3(RATIO_GRID_M, f107, f107a, ap, doy, 51.6, None, **RATIO_NODES)
     bin_rho = mean_density_kg_m3(RATIO_GRID_M, *binned[:1] * 2, binned[1], 51.6, None, None, **RATIO_NODES)
     np.testing.assert_allclose(model.log_ratio(daily, binned), np.log(exact / bin_rho), rtol=1e-10, atol=1e-12)
     assert len(air_table(51.6, None, model.version)) >= len(set(daily)) + SEASON_NODES
@@ -105,3 +112,99 @@ def test_the_table_is_rewritten_when_it_has_grown_by_a_quarter_and_at_the_end(tm
     air.log_density(days[26:27])
     daily_air._store_all()  # what the end of the process runs
     assert len(table(tmp_path, monkeypatch)) == 27
+
+
+#: A storm day's key: its indices, then the 27 3-hourly ap from 57 h before its first slot to its last: those
+#: of 2003-10-26 (from its sixth slot) to 2003-10-29 in CelesTrak's SW-All.txt (tests/decay/test_solar_record.py).
+STORM_KEY = (
+    *(270.9, 144.8, 204.0, 302.0),
+    *(4.0, 18.0, 22.0, 22.0, 18.0, 18.0, 7.0, 7.0, 9.0, 5.0, 4.0),
+    *(15.0, 39.0, 22.0, 39.0, 12.0, 27.0, 18.0, 27.0),
+    *(39.0, 27.0, 400.0, 207.0, 179.0, 179.0, 300.0, 300.0),
+)
+
+
+def direct_row(key, heights_m=HEIGHTS_M, inclination_deg=51.6, latitude_nodes=4, local_time_nodes=4):
+    """A day's row from pymsis itself: a storm key through the day's eight 3-hour slots in storm-time mode."""
+    if len(key) == 4:
+        return orbit_mean_density_by_day_kg_m3(
+            heights_m,
+            *([v] for v in key),
+            inclination_deg,
+            None,
+            latitude_nodes=latitude_nodes,
+            local_time_nodes=local_time_nodes,
+        )[0]
+    f107, f107a, ap, doy = key[:4]
+    ap3 = np.array(key[4:])
+    lat, local_time = orbit_samples(inclination_deg, None, latitude_nodes, local_time_nodes)
+    alts_km = geodetic_altitude_m(heights_m[None, :], lat[:, None]) / 1e3  # (samples, heights)
+    total = np.zeros(heights_m.size)
+    for slot in range(8):
+        ut_h = 1.5 + 3.0 * slot  # the slot's middle
+        now = 19 + slot  # the slot's place in the 27
+        # pymsis.calculate's docstring: daily Ap; ap now, 3, 6 and 9 h before; means of 12-33 h and 36-57 h before.
+        history = [
+            ap,
+            *ap3[[now, now - 1, now - 2, now - 3]],
+            ap3[now - 11 : now - 3].mean(),
+            ap3[now - 19 : now - 11].mean(),
+        ]
+        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(((doy - 1.0) * 24.0 + ut_h) * 3600.0), "s")
+        n = alts_km.size
+        out = pymsis.calculate(
+            np.full(n, date),
+            np.repeat(np.mod((local_time - ut_h) * 15.0, 360.0), heights_m.size),
+            np.repeat(lat, heights_m.size),
+            alts_km.ravel(),
+            np.full(n, f107),
+            np.full(n, f107a),
+            np.tile(history, (n, 1)),
+            version=2.1,
+            geomagnetic_activity=-1,
+        )
+        # pymsis returns float32: the mean is taken in float64, as the package does.
+        total += np.asarray(out[:, 0], dtype=np.float64).reshape(lat.size, heights_m.size).mean(axis=0)
+    return total / 8.0
+
+
+def test_a_storm_days_row_is_nrlmsis_storm_time_mode_through_its_slots(tmp_path, monkeypatch):
+    rows = table(tmp_path, monkeypatch).log_density([*KEYS, STORM_KEY])
+    np.testing.assert_allclose(np.exp(rows[-1]), direct_row(STORM_KEY), rtol=RTOL)
+    # The storm-time mode is what the row holds: the Halloween storm's history against the daily Ap alone.
+    daily = direct_row(STORM_KEY[:4])
+    assert np.all(np.abs(np.exp(rows[-1]) / daily - 1.0) > 0.02)
+
+
+def test_daily_rows_are_unchanged_bit_for_bit_by_storm_rows_beside_them(tmp_path, monkeypatch):
+    alone = table(tmp_path / "a", monkeypatch).log_density(KEYS)
+    mixed = table(tmp_path / "b", monkeypatch).log_density([KEYS[0], STORM_KEY, *KEYS[1:]])
+    np.testing.assert_array_equal(mixed[[0, 2, 3]], alone)
+    for key, row in zip(KEYS, alone, strict=True):
+        np.testing.assert_allclose(np.exp(row), direct(key), rtol=RTOL)
+
+
+def test_storm_rows_come_back_from_the_disk_cache_under_their_own_keys(tmp_path, monkeypatch):
+    first = table(tmp_path, monkeypatch)
+    rows = first.log_density([*KEYS, STORM_KEY])
+    first.store()
+    monkeypatch.setattr(daily_air, "orbit_mean_density_by_day_kg_m3", pytest.fail)
+    again = table(tmp_path, monkeypatch)
+    assert len(again) == 4
+    np.testing.assert_array_equal(again.log_density([STORM_KEY, *KEYS]), rows[[3, 0, 1, 2]])
+
+
+def test_storm_days_are_those_whose_3_hourly_ap_reach_the_threshold():
+    record = load_record()
+    start = unix_days("2003-10-20")
+    days = start + np.arange(20.0)
+    storm = SolarDecayModel(record, start, 28.5).daily_indices(days)
+    plain = SolarDecayModel(record, start, 28.5, storm_ap=False).daily_indices(days)
+    history = record.ap_history(days)
+    for key, quiet, ap3 in zip(storm, plain, history, strict=True):
+        assert len(quiet) == 4 and key[:4] == quiet
+        if ap3.max() >= STORM_AP:
+            assert key[4:] == tuple(ap3)
+        else:
+            assert key == quiet  # a quiet day keeps its daily-Ap key: the same row as before
+    assert 0 < sum(len(key) > 4 for key in storm) < len(storm)

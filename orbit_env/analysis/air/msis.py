@@ -46,6 +46,10 @@ class MsisAir(Air):
             season averaged, for an activity placed on a date that is not the orbit's).
         version: NRLMSIS version: 2.1 (default), 2.0, or 0.0 for NRLMSISE-00 (to compare
             with tools that run it: STK, Orekit).
+        storm_ap: The time-stepped path takes NRLMSIS's storm-time mode (3-hourly ap history) on
+            the storm days of an activity that has the 3-hourly ap (the CelesTrak record);
+            False (``--daily-ap``): the daily Ap every day
+            (`orbit_env.decay.chunked.SolarDecayModel`).
     """
 
     name: ClassVar[str] = "msis"
@@ -61,6 +65,7 @@ class MsisAir(Air):
         "epoch",
         "node_local_time",
         "msis_version",
+        "daily_ap",
     )
 
     activity: SolarActivity | None = None
@@ -68,6 +73,7 @@ class MsisAir(Air):
     ascending_node_local_time_h: float | None = None
     follow_season: bool = True
     version: float = DEFAULT_MSIS_VERSION
+    storm_ap: bool = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "version", check_msis_version(self.version))
@@ -121,7 +127,8 @@ class MsisAir(Air):
         if text_version is not None and text_version not in MSIS_VERSION_CHOICES:
             raise ValueError(f"--msis-version must be one of {', '.join(MSIS_VERSION_CHOICES)}, got {text_version!r}")
         version = DEFAULT_MSIS_VERSION if text_version is None else MSIS_VERSION_CHOICES[text_version]
-        return cls(activity, epoch, options.get("node_local_time"), version=version)
+        storm_ap = not options.get("daily_ap")
+        return cls(activity, epoch, options.get("node_local_time"), version=version, storm_ap=storm_ap)
 
     def profile(self, inclination_deg: float, scale: float = 1.0) -> MsisAtmosphere:
         """The profile of constant activity, averaged over the year (an air without a date)."""
@@ -159,6 +166,7 @@ class MsisAir(Air):
             follow_season=self.follow_season,
             ascending_node_local_time_h=self.ascending_node_local_time_h,
             version=self.version,
+            storm_ap=self.storm_ap,
             **settings,
         )
 
@@ -226,4 +234,6 @@ class MsisAir(Air):
         where = f"inclination {inclination_deg:g} deg"
         if self.ascending_node_local_time_h is not None:
             where += f", node at {self.ascending_node_local_time_h:g} h local time"
+        if not self.storm_ap:
+            what += ", daily Ap only (--daily-ap)"
         return f"{MSIS_VERSION_NAMES[self.version]}, {what}, {where}{details}"

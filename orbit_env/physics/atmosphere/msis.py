@@ -40,7 +40,9 @@ the model's own uncertainty (~15%).
 
 The indices are held fixed: F10.7 of the day before (``f107_sfu``), its 81-day
 centred mean (``f107a_sfu``) and the daily Ap (``ap``), all seven Ap slots equal.
-For activity that changes over a lifetime see `orbit_env.decay.solar`.
+For activity that changes over a lifetime see `orbit_env.decay.solar`; on its storm
+days a day's average can take NRLMSIS's storm-time mode instead, each 3-hour slot with
+its own ap history (``ap_history``, `ap_histories`).
 
 Table: ``ALTITUDE_GRID_M`` (40-6000 km, 2 km steps where the scale height is short;
 below 40 km the 40 km value is held: no decay computed here reaches that low);
@@ -219,19 +221,24 @@ def _msis_density(
     f107a_sfu: ArrayLike,
     ap: ArrayLike,
     version: float = DEFAULT_MSIS_VERSION,
+    ut_hours: ArrayLike = _UT_HOURS,
 ) -> FloatArray:
     """NRLMSIS mass density [kg/m^3] on a grid, in one call: shape (groups, days, samples, altitudes).
 
     ``lat`` and ``local_time`` are (groups, samples) orbit samples; ``days`` are days of
     the year from 0; the indices are per day (or scalars); ``version`` one of `MSIS_VERSIONS`.
+    ``ap`` per day is the daily Ap (all seven of NRLMSIS's slots equal, its daily mode), or,
+    shape (days, 7), each day's ap history (`ap_histories`): NRLMSIS's storm-time mode.
+    ``ut_hours``: universal time of each day's samples (longitude sets the local time).
     """
     msis = require_pymsis()
-    lon = np.mod((local_time - _UT_HOURS) * 15.0, 360.0)
+    ut = np.broadcast_to(np.asarray(ut_hours, dtype=np.float64), (days.size,))
+    lon = np.mod((local_time[:, None, :] - ut[None, :, None]) * 15.0, 360.0)  # (groups, days, samples)
     shape = (lat.shape[0], days.size, lat.shape[1], altitude_m.size)
-    seconds = np.round((days + _UT_HOURS / 24.0) * 86400.0).astype("timedelta64[s]")
+    seconds = np.round((days + ut / 24.0) * 86400.0).astype("timedelta64[s]")
     dates = np.broadcast_to((_REFERENCE_YEAR_START + seconds)[None, :, None, None], shape).ravel()
     lats = np.broadcast_to(lat[:, None, :, None], shape).ravel()
-    lons = np.broadcast_to(lon[:, None, :, None], shape).ravel()
+    lons = np.broadcast_to(lon[:, :, :, None], shape).ravel()
     alts_km = geodetic_altitude_m(altitude_m[None, None, None, :], lat[:, None, :, None]) / 1e3
     alts_km = np.broadcast_to(alts_km, shape).ravel()
 
@@ -239,6 +246,12 @@ def _msis_density(
         per_day = np.broadcast_to(np.asarray(values, dtype=np.float64), (days.size,))
         return np.broadcast_to(per_day[None, :, None, None], shape).ravel()
 
+    ap_values = np.asarray(ap, dtype=np.float64)
+    if ap_values.ndim == 2:  # each day's ap history: the storm-time mode
+        histories = np.broadcast_to(ap_values[None, :, None, None, :], (*shape, 7)).reshape(-1, 7)
+        storm = {"geomagnetic_activity": -1.0}
+    else:
+        histories, storm = np.repeat(per_point(ap_values)[:, None], 7, axis=1), {}
     out = msis.calculate(
         dates,
         lons,
@@ -246,8 +259,9 @@ def _msis_density(
         alts_km,
         f107s=per_point(f107_sfu),
         f107as=per_point(f107a_sfu),
-        aps=np.repeat(per_point(ap)[:, None], 7, axis=1),
+        aps=histories,
         version=_pymsis_version(check_msis_version(version)),
+        **storm,
     )
     return np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
 
@@ -264,6 +278,7 @@ def mean_density_over_days_kg_m3(
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
     version: float = DEFAULT_MSIS_VERSION,
+    ap_history: ArrayLike | None = None,
 ) -> FloatArray:
     """Orbit-averaged NRLMSIS density [kg/m^3] (``version``), averaged again over days with their own indices.
 
@@ -271,6 +286,7 @@ def mean_density_over_days_kg_m3(
     the year ``day_of_year[k]`` (1-366). One NRLMSIS call for all of them. The mean
     of densities, not the density of mean indices: NRLMSIS responds to Ap
     concavely, so averaging the indices would overstate the density after storms.
+    ``ap_history``: NRLMSIS's storm-time mode through each day (`orbit_mean_density_by_day_kg_m3`).
     """
     rho = _orbit_samples_density(
         altitude_m,
@@ -283,6 +299,7 @@ def mean_density_over_days_kg_m3(
         latitude_nodes,
         local_time_nodes,
         version,
+        ap_history,
     )
     return rho.mean(axis=(0, 1))
 
@@ -299,11 +316,15 @@ def orbit_mean_density_by_day_kg_m3(
     latitude_nodes: int = LATITUDE_NODES,
     local_time_nodes: int = LOCAL_TIME_NODES,
     version: float = DEFAULT_MSIS_VERSION,
+    ap_history: ArrayLike | None = None,
 ) -> FloatArray:
     """Each day's orbit-averaged NRLMSIS density [kg/m^3], shape (days, altitudes), in one NRLMSIS call.
 
     The arguments are `mean_density_over_days_kg_m3`'s, which is the mean of these rows (up to
-    the order of the sums).
+    the order of the sums). With ``ap_history`` (days, slots, 7: each slot's ap history,
+    `ap_histories`), NRLMSIS runs in its storm-time mode at each of the day's slots (slot k at
+    universal time (k + 1/2) 24 / slots h, the orbit's local times kept), and a day's row is the
+    mean over its slots too; ``ap`` is then unused (the history's first element is the daily Ap).
     """
     rho = _orbit_samples_density(
         altitude_m,
@@ -316,8 +337,37 @@ def orbit_mean_density_by_day_kg_m3(
         latitude_nodes,
         local_time_nodes,
         version,
+        ap_history,
     )
     return rho.mean(axis=1)
+
+
+def ap_histories(daily_ap: ArrayLike, three_hourly_ap: ArrayLike) -> FloatArray:
+    """NRLMSIS's storm-time ap input at each 3-hour slot of days: shape (days, 8, 7).
+
+    Args:
+        daily_ap: Each day's Ap (the history's first element).
+        three_hourly_ap: Shape (days, 27): the 3-hourly ap from the slot 57 h before the day's
+            first slot (the sixth slot of three days before) to the day's last, oldest first.
+
+    Slot k's history (as `pymsis.calculate` documents it): the daily Ap; the ap of the slot,
+    of 3, 6 and 9 h before; the mean of the eight from 12 to 33 h before; of the eight from 36
+    to 57 h before.
+    """
+    ap3 = np.asarray(three_hourly_ap, dtype=np.float64)
+    now = np.arange(8) + 19  # the day's slots' places in the 27
+    back = now[:, None] - np.arange(20)[None, :]  # (slots, 20): the slot, then 1 to 19 slots before
+    past = ap3[:, back]  # (days, slots, 20)
+    daily = np.broadcast_to(np.asarray(daily_ap, dtype=np.float64)[:, None, None], (ap3.shape[0], 8, 1))
+    return np.concatenate(
+        [
+            daily,
+            past[..., :4],
+            past[..., 4:12].mean(axis=-1, keepdims=True),
+            past[..., 12:20].mean(axis=-1, keepdims=True),
+        ],
+        axis=-1,
+    )
 
 
 def _orbit_samples_density(
@@ -331,12 +381,37 @@ def _orbit_samples_density(
     latitude_nodes: int,
     local_time_nodes: int,
     version: float,
+    ap_history: ArrayLike | None = None,
 ) -> FloatArray:
-    """NRLMSIS at an orbit's samples on each day: shape (days, samples, altitudes)."""
+    """NRLMSIS at an orbit's samples on each day: shape (days, samples, altitudes).
+
+    With ``ap_history`` (days, slots, 7), the storm-time mode at each of the day's slots: shape
+    (days, slots x samples, altitudes).
+    """
     alt = np.atleast_1d(np.asarray(altitude_m, dtype=np.float64))
     lat, local_time = orbit_samples(inclination_deg, ascending_node_local_time_h, latitude_nodes, local_time_nodes)
     days = np.atleast_1d(np.asarray(day_of_year, dtype=np.float64)) - 1.0
-    return _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap, version)[0]
+    if ap_history is None:
+        return _msis_density(alt, lat[None, :], local_time[None, :], days, f107_sfu, f107a_sfu, ap, version)[0]
+    history = np.asarray(ap_history, dtype=np.float64)
+    count, slots = history.shape[:2]
+
+    def per_slot(values: ArrayLike) -> FloatArray:
+        return np.repeat(np.broadcast_to(np.asarray(values, dtype=np.float64), (count,)), slots)
+
+    ut = np.tile((np.arange(slots) + 0.5) * 24.0 / slots, count)
+    rho = _msis_density(
+        alt,
+        lat[None, :],
+        local_time[None, :],
+        per_slot(days),
+        per_slot(f107_sfu),
+        per_slot(f107a_sfu),
+        history.reshape(count * slots, 7),
+        version,
+        ut,
+    )[0]
+    return rho.reshape(count, slots * lat.size, alt.size)
 
 
 def mean_density_over_inclinations_kg_m3(
