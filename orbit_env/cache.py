@@ -1,6 +1,7 @@
 """A disk cache for the tables that take long to build: universal curves, NRLMSIS profiles, DP solutions.
 
-Each entry is one ``.npz`` file (compressed unless its arrays are already) of named arrays in the user's cache folder
+Each entry is one ``.npz`` file (compressed unless its arrays are already) of named arrays, or a folder of ``.npy``
+files that are mapped rather than read (the universal curves: ``store(..., mapped=True)``), in the user's cache folder
 (``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux),
 under a name made from a hash of everything that shapes the table: its kind, a
 description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
@@ -26,6 +27,7 @@ import dataclasses
 import functools
 import hashlib
 import os
+import shutil
 import tempfile
 import zipfile
 from pathlib import Path
@@ -110,34 +112,49 @@ def _path(kind: str, description: str) -> Path | None:
     return folder / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
 
 
-def load(kind: str, description: str | None) -> dict[str, np.ndarray] | None:
+def load(kind: str, description: str | None, *, mapped: bool = False) -> dict[str, np.ndarray] | None:
     """The cached arrays of a table, or None (not cached, no description, cache disabled or unreadable).
 
     Args:
         kind: The kind of table (``"curves"``, ``"msis"``, ``"dp"``): the file's prefix.
         description: What shapes the table (`describe`); None: not cacheable.
+        mapped: Map the arrays of a table stored with ``mapped=True`` (read-only) instead of
+            reading them: a caller that looks up a few cells of a large table reads only
+            their pages (a dated decay looks up tens of bins' 5 MB curves a few times each).
     """
     path = None if description is None else _path(kind, description)
-    if path is None or not path.is_file():
+    if path is None:
         return None
     try:
+        if mapped:
+            folder = path.with_suffix("")
+            # Read-only views of the mapped files, without memmap's slower methods (take).
+            return {f.stem: np.load(f, mmap_mode="r").view(np.ndarray) for f in folder.glob("*.npy")} or None
+        if not path.is_file():
+            return None
         with np.load(path, allow_pickle=False) as data:
             return {name: data[name] for name in data.files}
     except (OSError, ValueError, zipfile.BadZipFile, EOFError):
         return None  # unreadable (truncated by a crash, another format): built again and rewritten
 
 
-def store(kind: str, description: str | None, arrays: dict[str, np.ndarray], *, compress: bool = True) -> None:
+def store(
+    kind: str, description: str | None, arrays: dict[str, np.ndarray], *, compress: bool = True, mapped: bool = False
+) -> None:
     """Write a table's arrays to the cache, atomically; a cache that cannot be written is passed over.
 
     ``compress=False`` for arrays that are compressed already (deflating them again costs
-    seconds and saves nothing).
+    seconds and saves nothing). ``mapped=True``: a folder of ``.npy`` files instead of one
+    ``.npz``, for `load` to map (the arrays aligned as numpy writes them).
     """
     path = None if description is None else _path(kind, description)
     if path is None:
         return
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        if mapped:
+            _store_folder(path.with_suffix(""), arrays)
+            return
         handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
         try:
             with os.fdopen(handle, "wb") as file:
@@ -148,3 +165,21 @@ def store(kind: str, description: str | None, arrays: dict[str, np.ndarray], *, 
             raise
     except OSError:
         return
+
+
+def _store_folder(folder: Path, arrays: dict[str, np.ndarray]) -> None:
+    """The arrays as ``.npy`` files in ``folder``, written in a temporary folder renamed to it (atomic)."""
+    temporary = Path(tempfile.mkdtemp(dir=folder.parent, prefix=folder.name, suffix=".tmp"))
+    try:
+        for name, array in arrays.items():
+            np.save(temporary / f"{name}.npy", array, allow_pickle=False)
+        if folder.exists():  # unreadable (`load` gave None): replaced (a rename onto a folder with files fails)
+            shutil.rmtree(folder, ignore_errors=True)
+        os.replace(temporary, folder)
+    except OSError:  # another process wrote the folder in between: its copy stays
+        pass
+    finally:
+        if temporary.exists():
+            for file in temporary.iterdir():
+                file.unlink()
+            temporary.rmdir()

@@ -28,26 +28,36 @@ def test_descriptions_name_every_input_and_refuse_what_has_none():
 def test_curves_are_stored_once_and_read_back_identical(folder):
     model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 60e3))
     built = UniversalCurves(model)
-    files = list(folder.glob("curves-*.npz"))
-    assert len(files) == 1 and not list(folder.glob("*.tmp"))
+    # The curves are a folder of .npy files (mapped, not read, on loading).
+    (stored,) = folder.glob("curves-*")
+    assert sorted(f.name for f in stored.iterdir()) == ["a.npy", "b.npy", "q.npy"] and not list(folder.glob("*.tmp"))
     loaded = UniversalCurves(model)
+    assert not loaded.table_a.corners.flags.writeable  # mapped from the file
     np.testing.assert_array_equal(loaded.table_a.cells, built.table_a.cells)
     np.testing.assert_array_equal(loaded.table_b.cells, built.table_b.cells)
-    # Another model is another file.
+    hp, ha = np.array([300e3, 250e3]), np.array([400e3, 2500e3])
+    np.testing.assert_array_equal(loaded.locate(hp, ha).weighted_s, built.locate(hp, ha).weighted_s)
+    # Another model is another folder.
     UniversalCurves(DecayModel(ExponentialAtmosphere(2e-11, 400e3, 60e3)))
-    assert len(list(folder.glob("curves-*.npz"))) == 2
+    assert len(list(folder.glob("curves-*"))) == 2
 
 
 def test_a_damaged_file_is_built_again(folder):
     model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 50e3))
     built = UniversalCurves(model)
-    (path,) = folder.glob("curves-*.npz")
-    path.write_bytes(b"not a zip file")
-    assert cache.load("curves", cache.describe(model)) is None  # unreadable: as if not cached
+    (stored,) = folder.glob("curves-*")
+    (stored / "b.npy").write_bytes(b"not an array")
+    assert cache.load("curves", cache.describe(model), mapped=True) is None  # unreadable: as if not cached
     again = UniversalCurves(model)
     np.testing.assert_array_equal(again.table_b.cells, built.table_b.cells)
-    with np.load(path) as data:  # rewritten whole
-        assert set(data.files) == {"a", "b"}
+    # Rewritten whole.
+    np.testing.assert_array_equal(np.load(stored / "b.npy"), built.table_b.corners)
+    assert not list(folder.glob("*.tmp"))
+    # A table in one file likewise.
+    cache.store("dp", "a test table", {"values": np.arange(3.0)})
+    (path,) = folder.glob("dp-*.npz")
+    path.write_bytes(b"not a zip file")
+    assert cache.load("dp", "a test table") is None
 
 
 def test_the_cache_can_be_disabled(tmp_path, monkeypatch):
@@ -71,7 +81,7 @@ def test_no_cache_flag_writes_nothing(folder, monkeypatch, capsys):
     monkeypatch.setattr(cache, "_disabled", False)
     args[args.index("2e-11")] = "3e-11"  # another atmosphere: not in this process's memory either
     assert main(args) == 0
-    assert len(list(folder.glob("curves-*.npz"))) == 1
+    assert len(list(folder.glob("curves-*"))) == 1
     capsys.readouterr()
 
 

@@ -47,6 +47,7 @@ from orbit_env.decay.density_multiplier import (
     life_rate_ratio,
     log_density_slope_per_m,
     orbit_ratio,
+    uniform_gradient,
 )
 from orbit_env.decay.solar import SolarActivity, day_of_year
 from orbit_env.physics.atmosphere.msis import (
@@ -384,7 +385,7 @@ class SolarDecayModel:
                 return ratio
         table = log_ratio[None, :] if offsets is None else log_ratio[None, :] + offsets
         at_perigee = np.exp(interpolate_rows(table, RATIO_GRID_M, perigee_m))
-        ratio_slope = interpolate_rows(np.gradient(table, RATIO_GRID_M, axis=1), RATIO_GRID_M, perigee_m)
+        ratio_slope = interpolate_rows(uniform_gradient(table, RATIO_GRID_M), RATIO_GRID_M, perigee_m)
         atmosphere = self.bin_model(binned).atmosphere
         assert isinstance(atmosphere, MsisAtmosphere)
         density_slope = np.interp(perigee_m, ALTITUDE_GRID_M, log_density_slope_per_m(atmosphere))
@@ -501,6 +502,8 @@ def _daily_steps(
     n = label.size
     days = np.full(n, np.nan)
     nu, hp, ha = nu.copy(), hp.copy(), ha.copy()
+    # W left at each satellite's nu, kept from the lookup that gave its heights (the next step starts there).
+    w_left = curves.weighted_at(label, nu)[2]
 
     def rates(which: NDArray[np.intp], start: float, length: float) -> tuple[FloatArray, FloatArray]:
         """W left and dW/dt of ``which`` in the step from ``start`` (days) of ``length`` days."""
@@ -518,8 +521,7 @@ def _daily_steps(
             offsets=None if offsets is None else offsets[which],
             inclination_deg=None if inclination_deg is None else inclination_deg[which],
         )
-        _, _, w0 = curves.weighted_at(label[which], nu[which])
-        return w0, gcs[which] * ratio
+        return w_left[which], gcs[which] * ratio
 
     def move(which: NDArray[np.intp], start: float, length: float, w0: FloatArray, rate: FloatArray) -> None:
         target = w0 - rate * length * SECONDS_PER_DAY
@@ -528,7 +530,7 @@ def _daily_steps(
         going = which[~ended]
         if going.size:
             nu[going] = curves.nu_at_weight(label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
-            hp[going], ha[going], _ = curves.weighted_at(label[going], nu[going])
+            hp[going], ha[going], w_left[going] = curves.weighted_at(label[going], nu[going])
         if ended.any():
             nu[which[ended]] = 0.0
             hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))

@@ -144,6 +144,11 @@ def _coefficients(f00: FloatArray, f10: FloatArray, f01: FloatArray, f11: FloatA
 CORNER_LOOKUPS = 200
 
 
+def padded_corners(tables: FloatArray) -> FloatArray:
+    """Tables (k, nx, ny) at every grid point, edges repeated once, as `BilinearGrid` reads them: (nx+1, ny+1, k)."""
+    return np.ascontiguousarray(np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge").transpose(1, 2, 0))
+
+
 class BilinearGrid:
     """Bilinear interpolation of a stack of tables (k, nx, ny) on a regular grid, clamped at its edges.
 
@@ -165,9 +170,19 @@ class BilinearGrid:
     """
 
     def __init__(self, tables: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
-        k, nx, ny = tables.shape
+        self._set(padded_corners(tables), x0, dx, y0, dy)
+
+    @classmethod
+    def from_corners(cls, corners: FloatArray, x0: float, dx: float, y0: float, dy: float) -> BilinearGrid:
+        """The grid of `padded_corners` made before (the disk cache keeps them: no padding again on loading)."""
+        grid = cls.__new__(cls)
+        grid._set(np.ascontiguousarray(corners), x0, dx, y0, dy)
+        return grid
+
+    def _set(self, corners: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
         #: The tables at every grid point, edges repeated once, shape (nx + 1, ny + 1, k).
-        self.corners = np.ascontiguousarray(np.pad(tables, ((0, 0), (0, 1), (0, 1)), mode="edge").transpose(1, 2, 0))
+        self.corners = corners
+        nx, ny, k = corners.shape[0] - 1, corners.shape[1] - 1, corners.shape[2]
         self.k, self.nx, self.ny = k, nx, ny
         self._corner_lookups = 0
         self.x_scale, self.x_offset = 1.0 / dx, x0 / dx
@@ -513,16 +528,18 @@ class UniversalCurves:
         self.labels = np.arange(_LOWEST_LABEL, np.log(_eccentricity(REENTRY_ALTITUDE_M, _HA_TOP_M)), _LABEL_SPACING)
         # Half a second to integrate: kept on disk per model (orbit_env.cache).
         description = cache.describe(model)
-        tables = cache.load("curves", description)
-        if tables is None:
+        corners = cache.load("curves", description, mapped=True)
+        if corners is None or sorted(corners) != ["a", "b", "q"]:
             tables = self._build()
-            # Uncompressed (4.5 MB instead of 2.4): read back in 3 ms instead of 15, which is what a dated
-            # decay, visiting tens of bins' curves, waits for.
-            cache.store("curves", description, tables, compress=False)
+            corners = {"a": tables["a"], "b": tables["b"], "q": tables["b"][2:]}  # q: the mean period alone
+            corners = {name: padded_corners(table) for name, table in corners.items()}
+            # The grids' corners as they are read (no padding on loading), uncompressed (5 MB instead of 3), mapped
+            # rather than read: a dated decay visits tens of bins' curves for a few lookups each.
+            cache.store("curves", description, corners, mapped=True)
         label0 = float(self.labels[0])
-        self.table_a = BilinearGrid(tables["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
-        self.table_b = BilinearGrid(tables["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
-        self._table_q = BilinearGrid(tables["b"][2:], label0, _LABEL_SPACING, 0.0, _DTAU)  # the mean period alone
+        self.table_a = BilinearGrid.from_corners(corners["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
+        self.table_b = BilinearGrid.from_corners(corners["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
+        self._table_q = BilinearGrid.from_corners(corners["q"], label0, _LABEL_SPACING, 0.0, _DTAU)
 
     def _build(self) -> dict[str, FloatArray]:
         """Integrate the family and make its two tables: A (orbit -> curve, place) and B (curve, place -> orbit)."""
