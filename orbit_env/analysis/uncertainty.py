@@ -169,6 +169,7 @@ def lifetime_spread(
     samples: int = 1000,
     seed: int = 0,
     drag_sigma: float = DRAG_COEFFICIENT_SIGMA,
+    workers: int = 1,
 ) -> LifetimeSpread:
     """Monte Carlo lifetimes of one satellite (see the module docstring).
 
@@ -182,6 +183,7 @@ def lifetime_spread(
         seed: Seed of the random numbers.
         drag_sigma: Log-normal sigma of the drag parameter: `DRAG_COEFFICIENT_SIGMA` for a
             satellite of known mass and area, `ONE_SET_DRAG_SIGMA` for one element set's.
+        workers: Processes for the solar nodes (`propagate_nodes`); the results do not depend on it.
     """
     z_sun, density, drag = sample_factors(samples, seed, drag_sigma)
     scale = density * drag
@@ -191,8 +193,6 @@ def lifetime_spread(
         days, reentered = scenario.lifetime_days(perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
         return LifetimeSpread(float(days) / scale, np.full(scale.size, bool(reentered)), seed, sources)
     sources["solar_forecast"] = SOLAR_FORECAST_SIGMA
-    from orbit_env.decay.chunked import propagate
-
     base = scenario.solar_model(inclination_deg)
     activity = base.activity
     after = getattr(activity, "observed_end_days", -math.inf)
@@ -209,24 +209,84 @@ def lifetime_spread(
     up = np.zeros((nodes.size, z_sun.size), dtype=bool)
     # The nominal forecast's node first: it runs on the days the nominal lifetime ran just before
     # (the command line's), whose NRLMSIS ratios are still in chunked's in-memory cache.
+    runs: list[NodeRun] = []
     for k in np.argsort(np.abs(nodes), kind="stable"):
-        z = float(nodes[k])
         needed = np.flatnonzero((left == k) | (right == k))
-        if needed.size == 0:
-            continue
-        model = replace(base, activity=ScaledForecast(activity, math.exp(SOLAR_FORECAST_SIGMA * z), after))
-        height_p, height_a = np.full(needed.size, float(perigee_m)), np.full(needed.size, float(apogee_m))
-        result = propagate(
-            height_p, height_a, drag_parameter_m2_kg, model, density_scale=scale[needed] * scenario.density_scale
-        )
-        log_days[k, needed] = np.log(np.maximum(result.days, 1e-6))
-        up[k, needed] = result.reentered
+        if needed.size:
+            k_sun = math.exp(SOLAR_FORECAST_SIGMA * float(nodes[k]))
+            model = replace(base, activity=ScaledForecast(activity, k_sun, after))
+            runs.append((int(k), needed, model))
+    orbit = (float(perigee_m), float(apogee_m), float(drag_parameter_m2_kg))
+    for (k, needed, _), (days_k, reentered_k) in zip(
+        runs, propagate_nodes(orbit, runs, scale * scenario.density_scale, workers), strict=True
+    ):
+        log_days[k, needed] = np.log(np.maximum(days_k, 1e-6))
+        up[k, needed] = reentered_k
     cols = np.arange(z_sun.size)
     days = np.exp(log_days[left, cols] * (1.0 - w) + log_days[right, cols] * w)
     reentered = up[left, cols] & up[right, cols]
     cap = base.max_years * 365.25
     days = np.where(reentered, np.minimum(days, cap), cap)
     return LifetimeSpread(days, reentered, seed, sources)
+
+
+#: A solar node's run: its index, the samples that use it, and its decay model (the forecast scaled).
+NodeRun = tuple[int, NDArray[np.intp], Any]
+
+
+def propagate_nodes(
+    orbit: tuple[float, float, float], runs: list[NodeRun], density_scale: FloatArray, workers: int
+) -> list[tuple[FloatArray, NDArray[np.bool_]]]:
+    """Each node's samples propagated (`orbit_env.decay.chunked.propagate`): their days and whether they re-entered.
+
+    ``orbit`` is (perigee [m], apogee [m], drag parameter [m^2/kg]), ``density_scale`` every
+    sample's factor. With ``workers`` > 1 the nodes after the first run in as many spawned
+    processes while this one runs the first (the nominal forecast's, whose air is in memory);
+    the workers' new rows of the real Sun's air come back with their results
+    (`orbit_env.decay.daily_air.merge_rows`). Each node runs on its own arithmetic, so the
+    results are the same bit for bit in any process.
+    """
+    from orbit_env.decay import daily_air
+
+    if workers <= 1 or len(runs) <= 1:
+        return [_propagate_node(orbit, model, density_scale[needed])[:2] for _, needed, model in runs]
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = ProcessPoolExecutor(min(workers, len(runs) - 1), mp_context=multiprocessing.get_context("spawn"))
+    try:
+        futures = [
+            pool.submit(_propagate_node, orbit, model, density_scale[needed], True) for _, needed, model in runs[1:]
+        ]
+        _, needed, model = runs[0]
+        results = [_propagate_node(orbit, model, density_scale[needed])[:2]]
+        for future in futures:
+            days, reentered, rows = future.result()
+            daily_air.merge_rows(rows)
+            results.append((days, reentered))
+    except BaseException:
+        # Ctrl-C or a failed node: stop the workers now rather than wait for their nodes.
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
+        pool.shutdown(cancel_futures=True)
+        raise
+    pool.shutdown()
+    return results
+
+
+def _propagate_node(
+    orbit: tuple[float, float, float], model: Any, density_scale: FloatArray, worker: bool = False
+) -> tuple[FloatArray, NDArray[np.bool_], Any]:
+    """One node's samples (`propagate_nodes`); in a worker, also the air rows it computed."""
+    from orbit_env.decay import daily_air
+    from orbit_env.decay.chunked import propagate
+
+    perigee_m, apogee_m, drag_parameter_m2_kg = orbit
+    size = density_scale.size
+    result = propagate(
+        np.full(size, perigee_m), np.full(size, apogee_m), drag_parameter_m2_kg, model, density_scale=density_scale
+    )
+    return result.days, result.reentered, daily_air.new_rows() if worker else None
 
 
 def spread_report(spread: LifetimeSpread, epoch_days: float | None, rule_years: float | None) -> dict[str, Any]:

@@ -407,7 +407,8 @@ def add_parsers(sub: Any) -> None:
         "--workers",
         type=positive_int,
         metavar="N",
-        help="with --batch --uncertainty: processes for the chunks of rows (default: all cores, os.cpu_count())",
+        help="with --uncertainty: processes for the solar nodes of a dated decay, with --batch for the chunks of "
+        "rows (default: all cores, os.cpu_count(); the results do not depend on it)",
     )
     life.add_argument(
         "--address",

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -367,6 +368,7 @@ def uncertainty(
         samples=args.samples,
         seed=args.seed,
         **({} if drag_sigma is None else {"drag_sigma": drag_sigma}),
+        workers=args.workers or os.cpu_count() or 1,
     )
     epoch = result.epoch_days
     if epoch is None and orbit.elements is not None:

@@ -56,14 +56,15 @@ class ChunkRecords:
 
 
 def check_options(args: argparse.Namespace) -> None:
-    """Refuse ``--workers``/``--address`` without ``--batch --uncertainty``; check the Monte Carlo's options.
+    """Refuse ``--workers`` without ``--uncertainty``, ``--address`` without ``--batch --uncertainty``; check the rest.
 
     Raises:
         ValueError: as said.
     """
-    for name in ("workers", "address"):
-        if getattr(args, name) is not None and not (args.batch and args.uncertainty):
-            raise ValueError(f"--{name} goes with --batch FILE --uncertainty (the rows' bands run in chunks)")
+    if args.workers is not None and not args.uncertainty:
+        raise ValueError("--workers goes with --uncertainty (its solar nodes, or with --batch its chunks of rows)")
+    if args.address is not None and not (args.batch and args.uncertainty):
+        raise ValueError("--address goes with --batch FILE --uncertainty (the rows' bands run in chunks)")
     if args.workers is not None and args.address is not None:
         raise ValueError("give --workers or --address, not both (on Ray, the cluster's CPUs run the chunks)")
     if args.address is not None:

@@ -169,19 +169,22 @@ class BilinearGrid:
     time; the uncertainty's samples look a bin up thousands of times, where the cells pay.
     """
 
-    def __init__(self, tables: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
-        self._set(padded_corners(tables), x0, dx, y0, dy)
-
-    @classmethod
-    def from_corners(cls, corners: FloatArray, x0: float, dx: float, y0: float, dy: float) -> BilinearGrid:
-        """The grid of `padded_corners` made before (the disk cache keeps them: no padding again on loading)."""
-        grid = cls.__new__(cls)
-        grid._set(np.ascontiguousarray(corners), x0, dx, y0, dy)
-        return grid
-
-    def _set(self, corners: FloatArray, x0: float, dx: float, y0: float, dy: float) -> None:
+    def __init__(
+        self,
+        tables: FloatArray | None,
+        x0: float,
+        dx: float,
+        y0: float,
+        dy: float,
+        *,
+        corners: FloatArray | None = None,
+    ) -> None:
+        """``corners``: the tables' `padded_corners` made before (the disk cache keeps them), ``tables`` then None."""
+        if corners is None:
+            assert tables is not None, "a grid needs its tables or their corners"
+            corners = padded_corners(tables)
         #: The tables at every grid point, edges repeated once, shape (nx + 1, ny + 1, k).
-        self.corners = corners
+        self.corners = np.ascontiguousarray(corners)
         nx, ny, k = corners.shape[0] - 1, corners.shape[1] - 1, corners.shape[2]
         self.k, self.nx, self.ny = k, nx, ny
         self._corner_lookups = 0
@@ -537,9 +540,9 @@ class UniversalCurves:
             # rather than read: a dated decay visits tens of bins' curves for a few lookups each.
             cache.store("curves", description, corners, mapped=True)
         label0 = float(self.labels[0])
-        self.table_a = BilinearGrid.from_corners(corners["a"], REENTRY_ALTITUDE_M, _DH_M, label0, _DY)
-        self.table_b = BilinearGrid.from_corners(corners["b"], label0, _LABEL_SPACING, 0.0, _DTAU)
-        self._table_q = BilinearGrid.from_corners(corners["q"], label0, _LABEL_SPACING, 0.0, _DTAU)
+        self.table_a = BilinearGrid(None, REENTRY_ALTITUDE_M, _DH_M, label0, _DY, corners=corners["a"])
+        self.table_b = BilinearGrid(None, label0, _LABEL_SPACING, 0.0, _DTAU, corners=corners["b"])
+        self._table_q = BilinearGrid(None, label0, _LABEL_SPACING, 0.0, _DTAU, corners=corners["q"])
 
     def _build(self) -> dict[str, FloatArray]:
         """Integrate the family and make its two tables: A (orbit -> curve, place) and B (curve, place -> orbit)."""

@@ -18,7 +18,10 @@ process ends: a later run, in any process, reads it in milliseconds and calls NR
 only for days it has never seen. (Written at every growth, the uncertainty's samples,
 whose scaled forecasts are days never seen, rewrote a growing table hundreds of times.)
 The rows are NRLMSIS's own values for those indices (a memo, not an interpolation), so
-results do not change with what is cached. Units: SI (m, kg/m^3).
+results do not change with what is cached. Worker processes (the uncertainty's solar
+nodes) hand the rows they computed back to their parent (`new_rows`, `merge_rows`), which
+writes them with its own: two processes writing one table would keep only one's rows.
+Units: SI (m, kg/m^3).
 
 **Storm days.** A day the decay counts as a storm day (`orbit_env.decay.chunked.STORM_AP`)
 has a longer key: its four indices, then the 27 3-hourly ap NRLMSIS's storm-time mode
@@ -99,7 +102,7 @@ class DailyAirTable:
         else:
             self._keys, self._log_rho = stored["keys"], stored["log_density"]
         self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(_unpadded, self._keys.tolist()))}
-        self._stored_rows = len(self._row_of)
+        self._stored_rows = self._read_rows = len(self._row_of)
         _TABLES.add(self)
 
     def __len__(self) -> int:
@@ -145,6 +148,10 @@ class DailyAirTable:
                 version=self.version,
                 ap_history=ap_histories(ap, values[:, DAILY_KEY:]) if storm else None,
             )
+        self._append(new, np.log(rho))
+
+    def _append(self, new: list[DayKey], log_rho: FloatArray) -> None:
+        """Hold the rows ``log_rho`` of the keys ``new`` (none held yet); written when the table has grown enough."""
         start = len(self._row_of)
         width = max(self._keys.shape[1], max(map(len, new)))
         added = np.full((len(new), width), np.nan)
@@ -152,10 +159,26 @@ class DailyAirTable:
             added[row, : len(key)] = key
         held = np.pad(self._keys, ((0, 0), (0, width - self._keys.shape[1])), constant_values=np.nan)
         self._keys = np.concatenate([held, added])
-        self._log_rho = np.concatenate([self._log_rho, np.log(rho)])
+        self._log_rho = np.concatenate([self._log_rho, log_rho])
         self._row_of.update({key: start + k for k, key in enumerate(new)})
         if len(self) >= STORE_GROWTH * self._stored_rows:
             self.store()
+
+    def settings(self) -> tuple[tuple[float, ...], float, float | None, float, int, int]:
+        """The arguments of `daily_air_table` that give this table (in any process)."""
+        heights = tuple(self.heights_m.tolist())
+        node = self.ascending_node_local_time_h
+        return heights, self.inclination_deg, node, self.version, self.latitude_nodes, self.local_time_nodes
+
+    def new_rows(self) -> tuple[list[DayKey], FloatArray]:
+        """The keys and rows this process added to the table since it read it from the disk cache."""
+        return list(self._row_of)[self._read_rows :], self._log_rho[self._read_rows :]
+
+    def merge(self, keys: Sequence[DayKey], log_rho: FloatArray) -> None:
+        """Hold rows another process computed (`new_rows` of a worker's table), but for keys held already."""
+        fresh = [k for k, key in enumerate(keys) if key not in self._row_of]
+        if fresh:
+            self._append([tuple(keys[k]) for k in fresh], np.asarray(log_rho)[fresh])
 
     def store(self) -> None:
         """Write the table to the disk cache if it holds rows not written yet."""
@@ -170,6 +193,22 @@ def _unpadded(stored: list[float]) -> DayKey:
     """A key as the table stores it (NaN-padded to the widest key) back to its own length."""
     key = tuple(stored)
     return key if len(key) == DAILY_KEY or not np.isnan(key[DAILY_KEY]) else key[:DAILY_KEY]
+
+
+#: The new rows of a process's tables (`new_rows`): each table's `DailyAirTable.settings`, keys and rows.
+NewRows = list[tuple[tuple[tuple[float, ...], float, float | None, float, int, int], list[DayKey], FloatArray]]
+
+
+def new_rows() -> NewRows:
+    """Every table's rows this process has added: what a worker process hands back to its parent (`merge_rows`)."""
+    rows = [(table.settings(), *table.new_rows()) for table in list(_TABLES)]
+    return [row for row in rows if row[1]]
+
+
+def merge_rows(rows: NewRows) -> None:
+    """Hold in this process's tables the rows other processes computed (`new_rows`); written to disk as any."""
+    for settings, keys, log_rho in rows:
+        daily_air_table(*settings).merge(keys, log_rho)
 
 
 @atexit.register

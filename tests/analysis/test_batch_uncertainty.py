@@ -220,7 +220,7 @@ def test_bad_options_are_one_line_errors(capsys, tmp_path, options, message):
     assert not catalogue_parts.parts_folder(out).exists()
 
 
-def test_workers_need_a_batch_with_uncertainty(capsys, tmp_path):
+def test_workers_need_uncertainty_and_the_address_a_batch(capsys, tmp_path):
     sats = tmp_path / "sats.csv"
     sats.write_text(SATELLITES)
     out = tmp_path / "out.csv"
@@ -229,9 +229,14 @@ def test_workers_need_a_batch_with_uncertainty(capsys, tmp_path):
     assert stop.value.code == 2
     assert "argument --workers: must be a positive integer, got 0" in capsys.readouterr().err
     status, _, err = run(capsys, "lifetime", "--batch", sats, "--out", out, "--workers", 2)
-    assert status == 2 and "--workers goes with --batch FILE --uncertainty" in err
-    status, _, err = run(capsys, "lifetime", "--perigee", 400, "--apogee", 400, "--uncertainty", "--workers", 2)
-    assert status == 2 and "--workers goes with --batch FILE --uncertainty" in err
+    assert status == 2 and "--workers goes with --uncertainty" in err
+    status, _, err = run(capsys, "lifetime", "--perigee", 400, "--apogee", 400, "--workers", 2)
+    assert status == 2 and "--workers goes with --uncertainty" in err
+    status, _, err = run(capsys, "lifetime", "--perigee", 400, "--apogee", 400, "--uncertainty", "--address", "local")
+    assert status == 2 and "--address goes with --batch FILE --uncertainty" in err
+    # One orbit's band takes --workers (its solar nodes' processes; a fixed profile has none to share).
+    status, out_text, _ = run(capsys, "lifetime", "--perigee", 400, "--apogee", 400, "--uncertainty", "--workers", 2)
+    assert status == 0 and "lifetime 5/50/95%" in out_text
 
 
 def test_dated_rows_repeat_across_workers_and_order(capsys, tmp_path):
