@@ -9,8 +9,9 @@ its ``source`` column names where every number comes from, and says "from memory
 no source was at hand). Every case uses the same rules, nothing fitted to a re-entry:
 
 * solar activity: the shipped CelesTrak record (`orbit_env.decay.solar_record.load_record`,
-  observed F10.7 of the previous day, its 81-day centred mean, daily Ap, from 1957-10-01),
-  through the time-stepped decay of :mod:`orbit_env.decay.chunked`;
+  observed F10.7 of the previous day, its 81-day centred mean, daily Ap, from 1957-10-01;
+  on storm days NRLMSIS's storm-time mode with the record's 3-hourly ap), through the
+  time-stepped decay of :mod:`orbit_env.decay.chunked`;
 * co-rotating air, the orbit's inclination (and the node's local time for the
   Sun-synchronous GOCE), published heights taken as above the equatorial radius;
 * the drag coefficient from ONE physical model, :mod:`orbit_env.physics.drag` (Sentman
