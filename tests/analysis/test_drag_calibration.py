@@ -186,7 +186,7 @@ def test_several_objects_in_one_file_are_an_error_naming_them(capsys, tmp_path):
 @pytest.mark.slow
 def test_real_reentries_from_element_sets_meet_the_goals():
     # benchmarks/validate_element_sets.py over the 32 objects (72 cases, ~13 minutes on 2 cores): measured
-    # one set median |error| 14.2%, history 10.3% with 90.6% of cases within +-25%, band coverage 91.5% and
+    # one set median |error| 14.2%, history 10.5% with 90.6% of cases within +-25%, band coverage 91.5% and
     # 90.6%. Held to issue 27's goals where they were met (one set median <= 20%, history 90% within
     # +-25%, the 90% band holding >= 85%) and, for the history's median (goal 10%), to 12%.
     import benchmark_scripts
