@@ -1,8 +1,8 @@
 """The cost of a dated lifetime (NRLMSIS 2.1 under the shipped record), cold and warm, and what the air table saves.
 
 Whole processes (``python -m orbit_env.cli lifetime ...``), as a user runs them, for a 3U
-cubesat (4 kg, 0.03 m^2, c_x 2.2) on three orbits whose lives are about 50 days, 1.2 years
-and 6.2 years. Each is timed in a disk cache of its own (a temporary folder):
+cubesat (4 kg, 0.03 m^2, c_x 2.2) on four orbits whose lives are about 50 days, 1.2, 4.9 and
+6.2 years. Each is timed in a disk cache of its own (a temporary folder):
 
 - **cold**: the cache empty (every bin's universal curves integrated, every day's air
   computed by NRLMSIS);
@@ -31,10 +31,11 @@ import time
 from pathlib import Path
 
 SATELLITE = ["--mass", "4", "--area", "0.03", "--cx", "2.2", "--atmosphere", "msis"]
-#: (perigee km, apogee km, inclination deg, epoch): lives of about 50 days, 1.2 and 6.2 years.
+#: (perigee km, apogee km, inclination deg, epoch): lives of about 50 days, 1.2, 4.9 and 6.2 years.
 CASES = [
     ("300", "350", "51.6", "2024-01-01"),
     ("400", "420", "51.6", "2015-01-01"),
+    ("460", "480", "97.5", "2019-01-01"),
     ("500", "520", "97.5", "2019-01-01"),
 ]
 COMPUTE = """
