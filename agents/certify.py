@@ -257,17 +257,21 @@ def _known_density_optimum(
     return _Optimum(plans, returns, burns)
 
 
-def _solar_plan(job: tuple[Any, dict[str, float]]) -> tuple[float, list[float]]:
-    """One mission's DP solved and flown (in a worker): its return and the burns it asked for, step by step."""
+def _solar_plan(job: tuple[Any, dict[str, float]], rollout: bool = False) -> tuple[float, list[float]]:
+    """One mission's DP solved and flown (in a worker): its return and the burns it asked for, step by step.
+
+    ``rollout``: the rollout policy on the DP flies (`SolarDP.rollout_burns_m_s`).
+    """
     from orbit_env.agents.solar import fly
     from orbit_env.agents.solar_dp import SolarDP
 
     task, option = job
     dp = SolarDP(task, option["start_day"])
     asked: list[float] = []
+    policy = dp.rollout_burns_m_s if rollout else dp.burns_m_s
 
     def act(state: Any) -> FloatArray:
-        burn = dp.burns_m_s(state)
+        burn = policy(state)
         asked.append(float(burn[0]))
         return burn
 
@@ -275,8 +279,18 @@ def _solar_plan(job: tuple[Any, dict[str, float]]) -> tuple[float, list[float]]:
     return float(flown.returns[0]), asked
 
 
+def _solar_rollout_plan(job: tuple[Any, dict[str, float]]) -> tuple[float, list[float]]:
+    """`_solar_plan` of the rollout policy (module level: worker processes take it by name)."""
+    return _solar_plan(job, rollout=True)
+
+
 def _solar_optimum(
-    episodes: int, seed: int, env_kwargs: dict[str, Any], workers: int | None, say: Callable[[str], None]
+    episodes: int,
+    seed: int,
+    env_kwargs: dict[str, Any],
+    workers: int | None,
+    say: Callable[[str], None],
+    rollout: bool = False,
 ) -> _Optimum:
     """The solar task's seeded missions, and each one's DP (`orbit_env.agents.solar_dp.SolarDP`) flown.
 
@@ -293,7 +307,7 @@ def _solar_optimum(
     options = starts(task, episodes, seed)
     plans = _Plans(SOLAR_ENV_ID, options, env_kwargs)
     say(f"dp: {episodes} missions, one DP each")
-    solved = map_missions(task, options, _solar_plan, workers)
+    solved = map_missions(task, options, _solar_rollout_plan if rollout else _solar_plan, workers)
     returns, burns = np.zeros(episodes), np.zeros((episodes, plans.horizon))
     for i, (value, asked) in enumerate(solved):
         returns[i] = value
@@ -344,7 +358,8 @@ def certify(
     start_time = time.perf_counter()
     say("dp (solving and playing)")
     if env_id == SOLAR_ENV_ID:
-        optimum = _solar_optimum(episodes, seed, {"solar_split": "test", **(env_kwargs or {})}, workers, say)
+        solar = {"solar_split": "test", **(env_kwargs or {})}
+        optimum = _solar_optimum(episodes, seed, solar, workers, say, rollout=dp_rollout)
     else:
         optimum = _known_density_optimum(env_id, episodes, seed, policy, dp_lookahead, dp_rollout)
     plans, dp_returns, dp_burns = optimum.plans, optimum.returns, optimum.burns_m_s

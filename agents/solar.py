@@ -311,14 +311,16 @@ def map_missions(
     return [solve(job) for job in jobs]
 
 
-def _fly_dp(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, float, float, bool, bool, float]:
-    """Solve one mission's DP and fly its policy (in a worker: the DP's tables stay there)."""
+def _fly_dp(
+    job: tuple[SolarTask, dict[str, float]], rollout: bool = False
+) -> tuple[float, float, float, float, bool, bool, float]:
+    """Solve one mission's DP and fly its policy, or the rollout on it (in a worker: the DP's tables stay there)."""
     from orbit_env.agents.solar_dp import SolarDP
 
     task, option = job
     options = {k: np.array([v]) for k, v in option.items()}
     dp = SolarDP(task, option["start_day"])
-    flown = fly(task, options, dp.burns_m_s)
+    flown = fly(task, options, dp.rollout_burns_m_s if rollout else dp.burns_m_s)
     start = solar_task.start(task, np.random.default_rng(0), 1, options)
     return (
         float(flown.returns[0]),
@@ -329,6 +331,11 @@ def _fly_dp(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, floa
         bool(flown.reentered[0]),
         float(dp.value(start)[0]),
     )
+
+
+def _fly_dp_rollout(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, float, float, bool, bool, float]:
+    """`_fly_dp` with the rollout policy (a module-level function: worker processes take it by name)."""
+    return _fly_dp(job, rollout=True)
 
 
 @dataclass(frozen=True)
@@ -347,6 +354,7 @@ def evaluate_solar(
     solar_split: str = "test",
     disposal_years: float = 5.0,
     include_dp: bool = True,
+    dp_rollout: bool = False,
     workers: int | None = None,
     progress: Callable[[str], None] | None = None,
     learned: Mapping[str, Any] | None = None,
@@ -354,7 +362,8 @@ def evaluate_solar(
     """Fly every hand-coded rule, the optimum and the ``learned`` agents on ``episodes`` missions of the split.
 
     The missions are drawn with ``seed``. ``learned``: row name -> a model answering SB3's ``predict``
-    (e.g. ``{"ppo": model}``), flown with deterministic actions after the optimum's row.
+    (e.g. ``{"ppo": model}``), flown with deterministic actions after the optimum's row. ``dp_rollout``:
+    the optimum's row is the rollout policy on each mission's DP (`SolarDP.rollout_burns_m_s`).
     """
     task = SolarTask(mission=SolarMission(solar_split=solar_split, disposal_years=disposal_years))
     options = starts(task, episodes, seed)
@@ -368,7 +377,7 @@ def evaluate_solar(
     estimate = np.full(episodes, np.nan)
     if include_dp:
         say(f"dp ({episodes} missions, one DP each)")
-        rows = map_missions(task, options, _fly_dp, workers)
+        rows = map_missions(task, options, _fly_dp_rollout if dp_rollout else _fly_dp, workers)
         columns = list(zip(*rows, strict=True))
         flown["dp"] = Flown(
             np.array(columns[0]),

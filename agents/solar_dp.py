@@ -45,6 +45,8 @@ LABEL_POINTS = 48
 MU_LOW = -14.0
 #: Masses at which a month's coast is computed per stage (full, half and empty tank; interpolated between).
 COAST_MASSES = 3
+#: Months from the start in which `SolarDP.rollout_burns_m_s` decides by flying every burn size to the end.
+ROLLOUT_STEPS = 6
 
 
 @dataclass(frozen=True)
@@ -216,6 +218,42 @@ class SolarDP:
     def value(self, state: BatchState) -> FloatArray:
         """V_0 at the states' starts: the grid's estimate of the optimum's return [days]."""
         return self._at_level(self._bilinear(self.start_values, state.label, state.tau), state.dv_left_m_s)
+
+    def rollout_burns_m_s(self, state: BatchState) -> FloatArray:
+        """The rollout policy on the DP: early on, the burn whose mission flown on with `burns_m_s` returns most.
+
+        In the first `ROLLOUT_STEPS` months every burn size is flown to the mission's end (the task's own
+        steps, not the grid), the DP policy acting after it; later the DP policy acts alone. Every
+        candidate's return is flown, and `burns_m_s`'s own burn is a candidate that wins ties, so the
+        rollout's return is never below the DP policy's (policy improvement on a deterministic task).
+        """
+        base = self.burns_m_s(state)
+        if int(state.steps[0]) >= ROLLOUT_STEPS:
+            return base
+        task = self.task
+        sizes = np.asarray(task.config.burn_sizes_m_s, dtype=np.float64)
+        n, a = state.size, sizes.size
+        trial = state.take(np.repeat(np.arange(n), a))
+        requested = np.tile(sizes, n)
+        total = np.zeros(n * a)
+        running = np.ones(n * a, dtype=bool)
+        while running.any():
+            rows = np.flatnonzero(running)
+            sub = trial.take(rows)
+            result = solar_task.step(task, sub, requested[rows])
+            trial.put(rows, sub)
+            total[rows] += result.reward
+            running[rows] = ~(result.terminated | result.truncated)
+            requested = np.zeros(n * a)
+            if running.any():
+                still = np.flatnonzero(running)
+                requested[still] = self.burns_m_s(trial.take(still))
+        total = total.reshape(n, a)
+        own = np.abs(sizes[None, :] - base[:, None]).argmin(axis=1)
+        best = total.argmax(axis=1)
+        rows = np.arange(n)
+        keep = total[rows, own] >= total[rows, best] - 1e-9
+        return np.where(keep, base, sizes[best])
 
     def burns_m_s(self, state: BatchState) -> FloatArray:
         """The burn each state should request now: the one-step look-ahead on U_k of its step."""

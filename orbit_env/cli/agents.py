@@ -98,6 +98,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         solar_split=args.solar_split,
         disposal_years=args.disposal_years,
         include_dp=not args.no_dp,
+        dp_rollout=args.dp_rollout,
         workers=args.workers,
         progress=say,
         learned=learned,
@@ -259,7 +260,8 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--dp-rollout",
         action="store_true",
-        help="the DP row is the rollout policy on the DP: certified, slower (see docs/dp.md)",
+        help="the DP row is the rollout policy on the DP: certified, slower (see docs/dp.md; "
+        "OrbitRaisingSolar-v0: its first months decided by flying every burn, docs/solar-task.md)",
     )
     ev.add_argument(
         "--certify",

@@ -270,6 +270,18 @@ def test_the_optimum_beats_every_rule_on_its_mission() -> None:
     assert dp.value(start)[0] == pytest.approx(dp_return, abs=30.0)
 
 
+def test_the_rollout_on_the_dp_never_flies_worse_than_the_dp() -> None:
+    # Policy improvement on a deterministic task: in its first months the rollout flies every burn size on
+    # with the DP policy and keeps the best, the DP's own burn winning ties, so its return cannot be lower.
+    task = TEST_TASK
+    options = starts(task, 3, 12345)  # the first missions `orbit-env evaluate` flies
+    for i in range(3):
+        one = {key: value[i : i + 1] for key, value in options.items()}
+        dp = SolarDP(task, float(one["start_day"][0]))
+        plain = fly(task, one, dp.burns_m_s).returns[0]
+        assert fly(task, one, dp.rollout_burns_m_s).returns[0] >= plain - 1e-9
+
+
 @pytest.mark.slow
 def test_evaluate_scores_the_test_split_by_default() -> None:
     out = subprocess.run(
