@@ -24,12 +24,11 @@ import csv
 import hashlib
 import json
 import math
-import multiprocessing
 import re
 import signal
 import threading
 from collections.abc import Callable, Iterable
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,6 +36,7 @@ from typing import Any
 from tqdm import tqdm
 
 from orbit_env.analysis.catalogue_io import atomic_text, write_records
+from orbit_env.workers import spawned_pool
 
 #: A chunk's rows at most: on the time-stepped path (a dated air, 1000 samples of a 13-year life take
 #: about 36 s a row), so a stopped run loses minutes, not hours; on a fixed profile (milliseconds a row).
@@ -160,14 +160,13 @@ def _run_pool(
     keep: Keep,
 ) -> None:
     """Run ``chunks`` (index, start, stop) on ``processes`` spawned workers; ``keep`` each chunk's records."""
-    context = multiprocessing.get_context("spawn")
-    executor = ProcessPoolExecutor(processes, mp_context=context, initializer=_start_worker, initargs=(compute,))
 
     def finished(futures: list[Future[Records]]) -> list[tuple[Any, Records]]:
         done, _ = wait(futures, return_when=FIRST_COMPLETED)
         return [(future, future.result()) for future in done]
 
-    try:
+    # Ctrl-C or a failed chunk stops the workers now; the parts kept so far stay for the next run.
+    with spawned_pool(processes, initializer=_start_worker, initargs=(compute,)) as executor:
         _drain(
             chunks,
             lambda start, stop: executor.submit(_compute_chunk, start, stop),
@@ -175,13 +174,6 @@ def _run_pool(
             QUEUED_PER_WORKER * processes,
             keep,
         )
-    except BaseException:
-        # Ctrl-C or a failed chunk: stop now; the parts kept so far stay for the next run.
-        for process in list((getattr(executor, "_processes", None) or {}).values()):
-            process.terminate()
-        executor.shutdown(cancel_futures=True)
-        raise
-    executor.shutdown()
 
 
 def _drain(

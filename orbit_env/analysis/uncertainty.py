@@ -250,11 +250,9 @@ def propagate_nodes(
 
     if workers <= 1 or len(runs) <= 1:
         return [_propagate_node(orbit, model, density_scale[needed])[:2] for _, needed, model in runs]
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+    from orbit_env.workers import spawned_pool
 
-    pool = ProcessPoolExecutor(min(workers, len(runs) - 1), mp_context=multiprocessing.get_context("spawn"))
-    try:
+    with spawned_pool(min(workers, len(runs) - 1)) as pool:  # Ctrl-C or a failed node stops the workers now
         futures = [
             pool.submit(_propagate_node, orbit, model, density_scale[needed], True) for _, needed, model in runs[1:]
         ]
@@ -264,13 +262,6 @@ def propagate_nodes(
             days, reentered, rows = future.result()
             daily_air.merge_rows(rows)
             results.append((days, reentered))
-    except BaseException:
-        # Ctrl-C or a failed node: stop the workers now rather than wait for their nodes.
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            process.terminate()
-        pool.shutdown(cancel_futures=True)
-        raise
-    pool.shutdown()
     return results
 
 
