@@ -34,6 +34,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, NamedTuple
 
 import gymnasium
@@ -279,11 +280,6 @@ def _solar_plan(job: tuple[Any, dict[str, float]], rollout: bool = False) -> tup
     return float(flown.returns[0]), asked
 
 
-def _solar_rollout_plan(job: tuple[Any, dict[str, float]]) -> tuple[float, list[float]]:
-    """`_solar_plan` of the rollout policy (module level: worker processes take it by name)."""
-    return _solar_plan(job, rollout=True)
-
-
 def _solar_optimum(
     episodes: int,
     seed: int,
@@ -307,7 +303,7 @@ def _solar_optimum(
     options = starts(task, episodes, seed)
     plans = _Plans(SOLAR_ENV_ID, options, env_kwargs)
     say(f"dp: {episodes} missions, one DP each")
-    solved = map_missions(task, options, _solar_rollout_plan if rollout else _solar_plan, workers)
+    solved = map_missions(task, options, partial(_solar_plan, rollout=rollout), workers)
     returns, burns = np.zeros(episodes), np.zeros((episodes, plans.horizon))
     for i, (value, asked) in enumerate(solved):
         returns[i] = value

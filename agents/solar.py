@@ -19,7 +19,7 @@ import os
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
-from functools import lru_cache
+from functools import lru_cache, partial
 from typing import Any
 
 import numpy as np
@@ -198,8 +198,18 @@ def fly(
     ``on_step(rows, states, result)``, if given, sees each step of the missions still flying: their
     rows, their states after the step and its result (`orbit_env.agents.solar_maps` records the flights).
     """
-    n = len(options["start_day"])
-    state = solar_task.start(task, np.random.default_rng(0), n, options)
+    state = solar_task.start(task, np.random.default_rng(0), len(options["start_day"]), options)
+    return fly_from(task, state, act, on_step)
+
+
+def fly_from(
+    task: SolarTask,
+    state: BatchState,
+    act: Callable[[BatchState], FloatArray],
+    on_step: Callable[[NDArray[np.intp], BatchState, SolarStep], None] | None = None,
+) -> Flown:
+    """`fly` from missions under way (``state``, flown on in place) instead of their starts."""
+    n = state.size
     total, dv, disposal = np.zeros(n), np.zeros(n), np.zeros(n)
     complies, reentered = np.ones(n, dtype=bool), np.zeros(n, dtype=bool)
     running = np.ones(n, dtype=bool)
@@ -333,11 +343,6 @@ def _fly_dp(
     )
 
 
-def _fly_dp_rollout(job: tuple[SolarTask, dict[str, float]]) -> tuple[float, float, float, float, bool, bool, float]:
-    """`_fly_dp` with the rollout policy (a module-level function: worker processes take it by name)."""
-    return _fly_dp(job, rollout=True)
-
-
 @dataclass(frozen=True)
 class SolarEvaluation:
     """Every policy on the same missions, and the optimum's estimate of itself."""
@@ -377,7 +382,7 @@ def evaluate_solar(
     estimate = np.full(episodes, np.nan)
     if include_dp:
         say(f"dp ({episodes} missions, one DP each)")
-        rows = map_missions(task, options, _fly_dp_rollout if dp_rollout else _fly_dp, workers)
+        rows = map_missions(task, options, partial(_fly_dp, rollout=dp_rollout), workers)
         columns = list(zip(*rows, strict=True))
         flown["dp"] = Flown(
             np.array(columns[0]),

@@ -230,25 +230,16 @@ class SolarDP:
         base = self.burns_m_s(state)
         if int(state.steps[0]) >= ROLLOUT_STEPS:
             return base
-        task = self.task
-        sizes = np.asarray(task.config.burn_sizes_m_s, dtype=np.float64)
+        from orbit_env.agents.solar import fly_from
+
+        sizes = np.asarray(self.task.config.burn_sizes_m_s, dtype=np.float64)
         n, a = state.size, sizes.size
-        trial = state.take(np.repeat(np.arange(n), a))
-        requested = np.tile(sizes, n)
-        total = np.zeros(n * a)
-        running = np.ones(n * a, dtype=bool)
-        while running.any():
-            rows = np.flatnonzero(running)
-            sub = trial.take(rows)
-            result = solar_task.step(task, sub, requested[rows])
-            trial.put(rows, sub)
-            total[rows] += result.reward
-            running[rows] = ~(result.terminated | result.truncated)
-            requested = np.zeros(n * a)
-            if running.any():
-                still = np.flatnonzero(running)
-                requested[still] = self.burns_m_s(trial.take(still))
-        total = total.reshape(n, a)
+        first = [np.tile(sizes, n)]  # the first step: every size from every state; then the DP's policy
+
+        def act(flying: BatchState) -> FloatArray:
+            return first.pop() if first else self.burns_m_s(flying)
+
+        total = fly_from(self.task, state.take(np.repeat(np.arange(n), a)), act).returns.reshape(n, a)
         own = np.abs(sizes[None, :] - base[:, None]).argmin(axis=1)
         best = total.argmax(axis=1)
         rows = np.arange(n)
