@@ -56,6 +56,7 @@ from orbit_env.physics.atmosphere.msis import (
     SEASON_NODES,
     MsisAtmosphere,
     check_msis_version,
+    season_days,
 )
 
 FloatArray = NDArray[np.float64]
@@ -172,8 +173,7 @@ def _log_bin_density(
     binned: tuple[float, float], inclination_deg: float, ascending_node_local_time_h: float | None, version: float
 ) -> FloatArray:
     """Ln of a bin's density on `RATIO_GRID_M`: its indices on `SEASON_NODES` days spread over the year, averaged."""
-    season = (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
-    keys = [(binned[0], binned[0], binned[1], float(doy)) for doy in season]
+    keys = [(binned[0], binned[0], binned[1], float(doy)) for doy in season_days()]
     log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(keys)
     return np.log(np.exp(log_rho).mean(axis=0))
 
@@ -268,8 +268,7 @@ class SolarDecayModel:
         columns = (np.round(f107, 1), np.round(f107a, 1), np.round(ap, 1), doy)
         per_day = 1
         if not self.follow_season:
-            nodes = (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
-            columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(nodes, days.size))
+            columns = (*(np.repeat(c, SEASON_NODES) for c in columns[:3]), np.tile(season_days(), days.size))
             per_day = SEASON_NODES
         keys = tuple(zip(*(c.tolist() for c in columns), strict=True))
         history = self.storm_history(days)

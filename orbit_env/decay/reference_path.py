@@ -23,11 +23,11 @@ from orbit_env.decay.solar import day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
-    SEASON_NODES,
     ap_histories,
     interpolate_log_density,
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
+    season_days,
 )
 from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
@@ -89,9 +89,7 @@ def _solve_reference(
                     version=model.version,
                 )
             else:  # a storm day (`orbit_env.decay.chunked.STORM_AP`): NRLMSIS's storm-time mode, as the decay
-                days = (
-                    np.array([doy]) if doy is not None else (np.arange(SEASON_NODES) + 0.5) * 365.0 / SEASON_NODES + 1.0
-                )
+                days = np.array([doy]) if doy is not None else season_days()
                 rho = mean_density_over_days_kg_m3(
                     ALTITUDE_GRID_M,
                     f107,

@@ -174,6 +174,11 @@ def geodetic_altitude_m(altitude_m: ArrayLike, latitude_deg: ArrayLike) -> Float
     return np.asarray(altitude_m, dtype=np.float64) + (EARTH_RADIUS_M - surface)
 
 
+def season_days(nodes: int = SEASON_NODES) -> FloatArray:
+    """The days of the year (1-366) at which a year's average takes NRLMSIS: ``nodes`` spread evenly, mid-interval."""
+    return (np.arange(nodes) + 0.5) * 365.0 / nodes + 1.0
+
+
 def mean_density_kg_m3(
     altitude_m: ArrayLike,
     f107_sfu: float,
@@ -193,10 +198,7 @@ def mean_density_kg_m3(
     The averaging is described in the module docstring. ``altitude_m`` is a 1-D
     array of heights above the package's spherical Earth.
     """
-    if day_of_year is None:
-        days = (np.arange(season_nodes) + 0.5) * 365.0 / season_nodes + 1.0
-    else:
-        days = np.array([float(day_of_year)])
+    days = season_days(season_nodes) if day_of_year is None else np.array([float(day_of_year)])
     ones = np.ones(days.size)
     return mean_density_over_days_kg_m3(
         altitude_m,
