@@ -146,10 +146,9 @@ class GreedyConstant(Never):
             if up.any():
                 end = weighted[up] - rate_s[up] * left_days[up]
                 label = trial.label[up]
-                nu = task.curves.nu_at_weight(
+                _, hp, ha, _ = task.curves.move_to_weight(
                     label, trial.nu[up], weighted[up], end, trial.perigee_m[up], trial.apogee_m[up]
                 )
-                hp, ha, _ = task.curves.weighted_at(label, nu)
                 allowed = rate_s[up] * task.mission.disposal_days
                 low, high = np.full(hp.shape, REENTRY_ALTITUDE_M), hp.copy()
                 complies = end <= allowed

@@ -73,6 +73,9 @@ LAST_DAYS = 4.0
 LAST_STEPS = 4
 #: A chunk goes in daily sub-steps when less than this many chunks of decay (at the chunk's rate) are left.
 FINE_CHUNKS = 3.0
+#: A step along the curves stops its Newton iterations once W is within this fraction of the step's fall
+#: (`UniversalCurves.move_to_weight`): a millionth of a day on a daily step, one or two lookups fewer.
+NEWTON_TOLERANCE = 1e-6
 #: Default cap on the time propagated [years]; a satellite still up then is reported as such.
 DEFAULT_MAX_YEARS = 200.0
 #: Near re-entry, orbits with a e / H above this take the multiplier from the averaged equations (W-weighted).
@@ -528,8 +531,9 @@ def _daily_steps(
         days[which[ended]] = start + w0[ended] / rate[ended] / SECONDS_PER_DAY
         going = which[~ended]
         if going.size:
-            nu[going] = curves.nu_at_weight(label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going])
-            hp[going], ha[going], w_left[going] = curves.weighted_at(label[going], nu[going])
+            nu[going], hp[going], ha[going], w_left[going] = curves.move_to_weight(
+                label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going], NEWTON_TOLERANCE
+            )
         if ended.any():
             nu[which[ended]] = 0.0
             hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))
@@ -785,12 +789,11 @@ def _propagate(
                     history_ha.append(ha.copy())
                     history_hp[-1][active[which]], history_ha[-1][active[which]] = hp_sub, ha_sub
         if coarse.any():
-            # Newton on W(nu) = target, dW/dnu = P; W is convex-ish and smooth, three steps reach 1e-10.
+            # Newton on W(nu) = target, dW/dnu = P (W is convex-ish and smooth).
             target = w0[coarse] - rate[coarse] * dt_s
-            nu_new[coarse] = curves.nu_at_weight(
-                label[coarse], nu0[coarse], w0[coarse], target, hp_new[coarse], ha_new[coarse]
+            nu_new[coarse], hp_new[coarse], ha_new[coarse], _ = curves.move_to_weight(
+                label[coarse], nu0[coarse], w0[coarse], target, hp_new[coarse], ha_new[coarse], NEWTON_TOLERANCE
             )
-            hp_new[coarse], ha_new[coarse], _ = curves.weighted_at(label[coarse], nu_new[coarse])
         hp[active], ha[active] = hp_new, ha_new
         keep = ~done
         label, tau = label[keep], np.log1p(nu_new[keep] / NU_REF)

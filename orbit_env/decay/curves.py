@@ -53,6 +53,8 @@ FloatArray = NDArray[np.float64]
 
 #: Newton steps of `UniversalCurves.locate_exactly` (bilinear cells: 2-3 from table A's point).
 LOCATE_NEWTON_STEPS = 4
+#: Lookups of W in `UniversalCurves.move_to_weight` at most (its first iterate, then three Newton steps).
+WEIGHT_LOOKUPS = 4
 
 #: Highest perigee height the curves cover [m].
 CURVES_MAX_PERIGEE_M = 1100e3
@@ -815,7 +817,7 @@ class UniversalCurves:
         hp, ha, q = self.at(label, np.log1p(nu / NU_REF))
         return hp, ha, q * nu
 
-    def nu_at_weight(
+    def move_to_weight(
         self,
         label: ArrayLike,
         nu: ArrayLike,
@@ -823,19 +825,30 @@ class UniversalCurves:
         target: ArrayLike,
         perigee_m: ArrayLike,
         apogee_m: ArrayLike,
-    ) -> FloatArray:
+        tolerance: float = 0.0,
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """The nu at which W falls to ``target`` along each curve, from nu (where W is ``weighted``, at those heights).
 
-        Newton's method on W(nu) = target with dW/dnu = P, the period at each iterate (four
-        steps: the table's own precision). Never below 0 (re-entry).
+        Returns nu (never below 0: re-entry), and the perigee [m], apogee [m] and W at it (its
+        last lookup). Newton's method on W(nu) = target with dW/dnu = P, the period at each iterate: the
+        first iterate from the period at the heights given, then up to `WEIGHT_LOOKUPS` lookups
+        of W. An orbit stops at the first iterate whose W is within ``tolerance`` times the
+        step (|W - target| <= tolerance |weighted - target|); each orbit's iterates are its
+        own, whatever the others in the arrays do. With ``tolerance`` 0, every lookup (the
+        table's own precision).
         """
         p_now, e_now = elements_from_heights(perigee_m, apogee_m)
         nu = np.maximum(np.asarray(nu, dtype=np.float64) - (weighted - target) / period_s(p_now, e_now), 0.0)
-        for _ in range(3):
-            hp_k, ha_k, w = self.weighted_at(label, nu)
-            p_k, e_k = elements_from_heights(hp_k, ha_k)
-            nu = np.maximum(nu - (w - target) / period_s(p_k, e_k), 0.0)
-        return nu
+        close = np.abs(np.subtract(weighted, target)) * tolerance
+        hp, ha, w = self.weighted_at(label, nu)
+        for _ in range(WEIGHT_LOOKUPS - 1):
+            going = np.abs(w - target) > close
+            if not going.any():
+                break
+            p_k, e_k = elements_from_heights(hp, ha)
+            nu = np.where(going, np.maximum(nu - (w - target) / period_s(p_k, e_k), 0.0), nu)
+            hp, ha, w = self.weighted_at(label, nu)
+        return nu, hp, ha, w
 
     def _at_scalar(self, mu: float, tau: float) -> tuple[float, float, float]:
         """`at` for one orbit, in plain floats (the arithmetic of `_heights`)."""

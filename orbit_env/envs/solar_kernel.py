@@ -15,7 +15,7 @@ curves as `orbit_env.envs.kernel` reads them (`orbit_env.envs.kernel.tables`, it
 `orbit_env.envs.kernel.cell`), and the clock's cumulative drag-days
 (`orbit_env.decay.drag_clock.drag_days_at`). ``tests/envs/test_solar_task.py`` holds the
 compiled loops equal to the uncompiled functions and the coast equal to the array
-lookups of `orbit_env.decay.curves.UniversalCurves` (``weighted_at``, ``nu_at_weight``).
+lookups of `orbit_env.decay.curves.UniversalCurves` (``weighted_at``, ``move_to_weight``).
 
 Units: SI (m, s); days for spans and the calendar (whole days since the record's first).
 """
@@ -92,7 +92,7 @@ def _nu_at_weight(
     b_cells: FloatArray,
     b_grid: FloatArray,
 ) -> float:
-    """`UniversalCurves.nu_at_weight` of one orbit: Newton's method on W(nu) = target, dW/dnu = P."""
+    """`UniversalCurves.move_to_weight`'s nu of one orbit, every lookup: Newton on W(nu) = target, dW/dnu = P."""
     nu = max(nu - (weighted - target) / _kepler_period_s(perigee_m, apogee_m), 0.0)
     for _ in range(3):
         hp, ha, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)

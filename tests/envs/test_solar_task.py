@@ -70,7 +70,7 @@ def _random_orbits(size: int, seed: int) -> tuple[st.BatchState, np.ndarray, np.
 
 
 def test_the_compiled_coast_is_the_curves_array_lookups() -> None:
-    # An independent path: UniversalCurves' array lookups (weighted_at, nu_at_weight: numpy) and the
+    # An independent path: UniversalCurves' array lookups (weighted_at, move_to_weight: numpy) and the
     # clock's array drag-days, against the compiled loop. Same formulas, other code: equal to 1e-12.
     task = TEST_TASK
     state, gc, day = _random_orbits(300, 5)
@@ -79,7 +79,7 @@ def test_the_compiled_coast_is_the_curves_array_lookups() -> None:
     drag = task.clock.drag_days(state.perigee_m, day, day + 30.0)
     target = weighted - gc * drag * 86400.0
     assert np.all(target > 0.0)  # 380-580 km: a month never ends them
-    nu = task.curves.nu_at_weight(state.label, state.nu, weighted, target, state.perigee_m, state.apogee_m)
+    nu = task.curves.move_to_weight(state.label, state.nu, weighted, target, state.perigee_m, state.apogee_m)[0]
     np.testing.assert_allclose(after.nu, nu, rtol=1e-12)
     np.testing.assert_allclose(after.ratio, drag / 30.0, rtol=1e-12)
     hp, ha, period = task.curves.at(state.label, np.log1p(nu / NU_REF))
