@@ -77,6 +77,7 @@ def _asymptotic_coefficients(order: int) -> FloatArray:
 
 
 _BESSEL_COS = np.cos(np.linspace(0.0, np.pi, BESSEL_INTERVALS + 1))
+_BESSEL_COS_LESS_1 = _BESSEL_COS - 1.0
 _BESSEL_WEIGHTS = np.full(BESSEL_INTERVALS + 1, 1.0 / BESSEL_INTERVALS)
 _BESSEL_WEIGHTS[[0, -1]] = 0.5 / BESSEL_INTERVALS
 _BESSEL_SERIES = np.stack([_asymptotic_coefficients(0), _asymptotic_coefficients(1)])
@@ -95,7 +96,8 @@ def scaled_bessel_i0_i1(x: ArrayLike) -> tuple[FloatArray, FloatArray]:
     """
     x = np.asarray(x, dtype=np.float64)
     near = np.minimum(x, BESSEL_SERIES_X)
-    integrand = np.exp(np.multiply.outer(near, _BESSEL_COS - 1.0)) * _BESSEL_WEIGHTS
+    integrand = np.exp(np.multiply.outer(near, _BESSEL_COS_LESS_1))
+    integrand *= _BESSEL_WEIGHTS
     i0, i1 = integrand.sum(axis=-1), integrand @ _BESSEL_COS
     far = x > BESSEL_SERIES_X
     if np.any(far):
@@ -144,7 +146,8 @@ def orbit_ratio(
     # e^-x (I0(x) + 2 e I1(x)) at x0 and x1 (one call: a decay's steps pass a few orbits at a time) from the scaled
     # Bessel functions (e^-|x| I(|x|)); x < 0 only for a ratio steeper than the density (not seen in NRLMSIS, kept
     # finite all the same).
-    x = np.stack(np.broadcast_arrays(x0, x1))
+    x = np.empty((2, *np.shape(x0 + x1)))
+    x[0], x[1] = x0, x1
     ax = np.abs(x)
     i0, i1 = scaled_bessel_i0_i1(ax)
     weight = np.exp(ax - x) * (i0 + 2.0 * e * np.sign(x) * i1)
@@ -170,8 +173,11 @@ def interpolate_rows(table: FloatArray, grid_m: FloatArray, height_m: FloatArray
     """Row k of ``height_m`` (any trailing shape) interpolated linearly in row k of ``table`` (rows, heights).
 
     ``grid_m`` is uniform (the rows' tables are read by index); heights beyond it take
-    its end values, as ``np.interp``. A table of one row serves every row of ``height_m``.
+    its end values, as ``np.interp``. A table of one row serves every row of ``height_m``
+    (``np.interp`` itself: a tenth of the cost on the few heights of a decay's daily step).
     """
+    if table.shape[0] == 1:
+        return np.interp(height_m, grid_m, table[0])
     return interpolate_rows_with_slope(table, grid_m, height_m)[0]
 
 
@@ -267,9 +273,13 @@ def life_rate_ratio(
         dp_row, de_row = (1.0 - cos_i) * dp_90 + cos_i * dp_0, (1.0 - cos_i) * de_90 + cos_i * de_0
     else:  # the rows' air moves as the curves' (still, or at their inclination)
         dp_row, de_row = kernel_rates(k_p[0], k_e[0], rho_row)
-    w0 = weight_left_s(curves, p, e) if weighted is None else weighted
-    w_p = (weight_left_s(curves, p + GRADIENT_STEP_P_M, e) - w0) / GRADIENT_STEP_P_M
-    w_e = (w0 - weight_left_s(curves, p, np.maximum(e - GRADIENT_STEP_E, 0.0))) / GRADIENT_STEP_E
+    # W at the orbits (unless given) and at the two steps, in one lookup of all the points.
+    points_p = [p + GRADIENT_STEP_P_M, p] + ([p] if weighted is None else [])
+    points_e = [e, np.maximum(e - GRADIENT_STEP_E, 0.0)] + ([e] if weighted is None else [])
+    w_up, w_down, *w_here = weight_left_s(curves, np.stack(points_p), np.stack(points_e))
+    w0 = w_here[0] if w_here else weighted
+    w_p = (w_up - w0) / GRADIENT_STEP_P_M
+    w_e = (w0 - w_down) / GRADIENT_STEP_E
     return np.asarray((w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref), dtype=np.float64)
 
 
