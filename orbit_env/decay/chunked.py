@@ -526,15 +526,16 @@ def _daily_steps(
     def move(which: NDArray[np.intp], start: float, length: float, w0: FloatArray, rate: FloatArray) -> None:
         target = w0 - rate * length * SECONDS_PER_DAY
         ended = target <= 0.0
-        days[which[ended]] = start + w0[ended] / rate[ended] / SECONDS_PER_DAY
-        going = which[~ended]
-        if going.size:
-            nu[going], hp[going], ha[going], w_left[going] = curves.move_to_weight(
-                label[going], nu[going], w0[~ended], target[~ended], hp[going], ha[going], NEWTON_TOLERANCE
-            )
         if ended.any():
-            nu[which[ended]] = 0.0
-            hp[which[ended]], ha[which[ended]], _ = curves.at(label[which[ended]], np.zeros(int(ended.sum())))
+            gone = which[ended]
+            days[gone] = start + w0[ended] / rate[ended] / SECONDS_PER_DAY
+            nu[gone] = 0.0
+            hp[gone], ha[gone], _ = curves.at(label[gone], np.zeros(gone.size))
+            which, w0, target = which[~ended], w0[~ended], target[~ended]
+        if which.size:
+            nu[which], hp[which], ha[which], w_left[which] = curves.move_to_weight(
+                label[which], nu[which], w0, target, hp[which], ha[which], NEWTON_TOLERANCE
+            )
 
     alive = np.arange(n)
     times: list[float] = []
@@ -546,9 +547,12 @@ def _daily_steps(
         # In its last days the perigee falls tens of km a day: the day takes the multiplier at the orbit of its
         # middle (reached by half the day at the start's), from the start again (the midpoint rule).
         last = w0 < rate * LAST_DAYS * SECONDS_PER_DAY
-        move(alive[~last], start, step_days, w0[~last], rate[~last])
-        close = alive[last]
-        if close.size:
+        if not last.any():
+            move(alive, start, step_days, w0, rate)
+        else:
+            if not last.all():
+                move(alive[~last], start, step_days, w0[~last], rate[~last])
+            close = alive[last]
             at_start = (nu[close], hp[close], ha[close], w_left[close])
             move(close, start, 0.5 * step_days, w0[last], rate[last])
             up = np.isnan(days[close])  # the others re-entered within the half day, at the start's rate
