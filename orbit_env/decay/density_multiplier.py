@@ -257,7 +257,7 @@ def life_rate_ratio(
     reference = model.atmosphere
     p, e = elements_from_heights(perigee_m, apogee_m)
     e = np.maximum(e, 0.0)
-    own = DecayModel(reference, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
+    own = _with_quadrature(model, quadrature_points)
     rows_turn = model.rotating_atmosphere and inclination_deg is not None
     # The air's speeds: the curves' own, and for rows at their inclinations cos i = 0 and 1.
     air_rad_s = (own.corotation_rad_s, 0.0, EARTH_ROTATION_RAD_S) if rows_turn else (own.corotation_rad_s,)
@@ -281,6 +281,12 @@ def life_rate_ratio(
     w_p = (w_up - w0) / GRADIENT_STEP_P_M
     w_e = (w0 - w_down) / GRADIENT_STEP_E
     return np.asarray((w_p * dp_row + w_e * de_row) / (w_p * dp_ref + w_e * de_ref), dtype=np.float64)
+
+
+@lru_cache(maxsize=64)
+def _with_quadrature(model: DecayModel, quadrature_points: int) -> DecayModel:
+    """``model`` on ``quadrature_points`` anomalies, built once (its rule's nodes are kept with it)."""
+    return DecayModel(model.atmosphere, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
 
 
 def inclination_anchors(inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
