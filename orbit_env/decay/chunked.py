@@ -550,8 +550,7 @@ def _daily_steps(
         if not last.any():
             move(alive, start, step_days, w0, rate)
         else:
-            if not last.all():
-                move(alive[~last], start, step_days, w0[~last], rate[~last])
+            move(alive[~last], start, step_days, w0[~last], rate[~last])
             close = alive[last]
             at_start = (nu[close], hp[close], ha[close], w_left[close])
             move(close, start, 0.5 * step_days, w0[last], rate[last])

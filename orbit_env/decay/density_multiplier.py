@@ -21,6 +21,7 @@ SI units.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from functools import lru_cache
 
 import numpy as np
@@ -146,7 +147,7 @@ def orbit_ratio(
     # e^-x (I0(x) + 2 e I1(x)) at x0 and x1 (one call: a decay's steps pass a few orbits at a time) from the scaled
     # Bessel functions (e^-|x| I(|x|)); x < 0 only for a ratio steeper than the density (not seen in NRLMSIS, kept
     # finite all the same).
-    x = np.empty((2, *np.shape(x0 + x1)))
+    x = np.empty((2, *np.shape(x0 + x1)))  # x0 + x1: their broadcast shape, in one ufunc call
     x[0], x[1] = x0, x1
     ax = np.abs(x)
     i0, i1 = scaled_bessel_i0_i1(ax)
@@ -286,7 +287,7 @@ def life_rate_ratio(
 @lru_cache(maxsize=64)
 def _with_quadrature(model: DecayModel, quadrature_points: int) -> DecayModel:
     """``model`` on ``quadrature_points`` anomalies, built once (its rule's nodes are kept with it)."""
-    return DecayModel(model.atmosphere, model.rotating_atmosphere, model.inclination_deg, quadrature_points)
+    return replace(model, quadrature_points=quadrature_points)
 
 
 def inclination_anchors(inclination_deg: FloatArray, reference_deg: float) -> FloatArray:
