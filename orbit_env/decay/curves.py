@@ -68,6 +68,11 @@ E_FLOOR = 1e-14
 
 # The curves run past the domain so that the cells at its edges are valid.
 _HP_TOP_M = CURVES_MAX_PERIGEE_M + 40e3
+# Table A's rows stop at _HP_TOP_M, the curves run on to here: a row's last crossing is where the last curve
+# that reaches its eccentricity meets it, and near the top adjacent curves meet a row some 40 km apart, so
+# curves stopped at _HP_TOP_M left rows without a crossing above 1095 km (their values held from below, and
+# lifetimes at 1095-1100 km perigee half what they are).
+_HP_INTEGRATE_TOP_M = _HP_TOP_M + 150e3
 _HA_TOP_M = 1.25 * CURVES_MAX_APOGEE_M
 _DH_M = 2e3  # perigee-height step of table A
 _TAU_TOP = 27.0  # nu up to 5e8, beyond any orbit in the domain
@@ -556,7 +561,11 @@ class UniversalCurves:
         # At re-entry W/nu is the period itself.
         e_end = np.exp(self.labels)
         q[:, 0] = period_s((REENTRY_ALTITUDE_M + EARTH_RADIUS_M) * (1 + e_end), e_end)
-        return {"a": self._build_table_a(hp, y, tau), "b": self._build_table_b(hp, y, q)}
+        # Table B (and every height it gives) keeps to the domain and its margin; only table A's rows
+        # need the curves beyond (`_HP_INTEGRATE_TOP_M`).
+        inside = hp <= _HP_TOP_M
+        hp_b, y_b, q_b = (np.where(inside, values, np.nan) for values in (hp, y, q))
+        return {"a": self._build_table_a(hp, y, tau, np.nanmax(y_b)), "b": self._build_table_b(hp_b, y_b, q_b)}
 
     def _slope(self, hp: FloatArray, y: FloatArray, dnu_dtau: float | FloatArray) -> FloatArray:
         """d/dtau of perigee height, ln(e) and W, backward from re-entry, one curve each."""
@@ -593,7 +602,7 @@ class UniversalCurves:
             s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
             e = np.exp(s[1])
             apogee = (EARTH_RADIUS_M + s[0]) * (1 + e) / (1 - e) - EARTH_RADIUS_M
-            keep = np.isfinite(s).all(axis=0) & (e < 0.5) & (apogee <= _HA_TOP_M) & (s[0] <= _HP_TOP_M)
+            keep = np.isfinite(s).all(axis=0) & (e < 0.5) & (apogee <= _HA_TOP_M) & (s[0] <= _HP_INTEGRATE_TOP_M)
             active = active[keep]
             state[:, active] = s[:, keep]
             out[:, active, index] = s[:, keep]
@@ -601,8 +610,8 @@ class UniversalCurves:
                 break
         return out[0], out[1], out[2]
 
-    def _build_table_a(self, hp: FloatArray, y: FloatArray, tau: FloatArray) -> FloatArray:
-        """Rows of constant ln(e), inverted from the curves to perigee height.
+    def _build_table_a(self, hp: FloatArray, y: FloatArray, tau: FloatArray, y_top: float) -> FloatArray:
+        """Rows of constant ln(e) up to ``y_top``, inverted from the curves to perigee height.
 
         Under drag e falls monotonically, so every curve crosses a row once, and
         a row meets the curves in order of their labels (they never cross). Rows,
@@ -614,7 +623,7 @@ class UniversalCurves:
         values at the same height.
         """
         labels = self.labels
-        y_grid = np.arange(labels[0], np.nanmax(y), _DY)
+        y_grid = np.arange(labels[0], y_top, _DY)
         hp_grid = np.arange(REENTRY_ALTITUDE_M, _HP_TOP_M, _DH_M)
         crossing = np.full((2, labels.size, y_grid.size), np.nan)
         for j in range(labels.size):
