@@ -1,12 +1,31 @@
-"""Worker processes: a pool of spawned processes that stops its workers at once on Ctrl-C or a failure."""
+"""Worker processes: a pool of spawned processes, and forked children for work beside this process.
+
+`spawned_pool` stops its workers at once on Ctrl-C or a failure. `Forked` has a forked child
+fill an array in shared memory while this process goes on; `in_two_processes` splits a large
+pointwise computation (NRLMSIS at many points) over this process and a forked child.
+"""
 
 from __future__ import annotations
 
+import atexit
+import math
+import mmap
 import multiprocessing
-from collections.abc import Iterator
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Points below which `in_two_processes` computes in this process alone: a fork costs a few milliseconds
+#: (measured 5-15 ms for a process with numpy and pymsis loaded), NRLMSIS 0.5-1 us a point.
+FORK_MIN_POINTS = 50_000
 
 
 @contextmanager
@@ -27,3 +46,151 @@ def spawned_pool(processes: int, **kwargs: Any) -> Iterator[ProcessPoolExecutor]
         executor.shutdown(cancel_futures=True)
         raise
     executor.shutdown()
+
+
+def _cores() -> int:
+    """The cores this process may run on."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
+
+
+def can_fork() -> bool:
+    """Whether a computation may be handed to a forked child here.
+
+    Linux only (fork elsewhere is unsafe or absent), at least two cores, and only in a
+    process that is neither a pool's worker nor a forked child, runs no other Python
+    thread (a fork copies one thread: a lock another thread holds would never be released
+    in the child; tqdm's monitor thread excepted, `_other_threads`) and has no worker
+    process or forked child still running (a second process beside busy ones would only
+    compete for the same cores).
+    """
+    return (
+        not _in_child
+        and sys.platform.startswith("linux")
+        and _cores() >= 2
+        and multiprocessing.parent_process() is None
+        and not _other_threads()
+        and not any(child.running() for child in list(_children))
+        and not multiprocessing.active_children()
+    )
+
+
+def _other_threads() -> int:
+    """Python threads beside this one, tqdm's monitor left out.
+
+    The monitor (a daemon thread that a progress bar starts and that outlives it) only wakes
+    to refresh bars, and a forked child draws none: its locks are never the child's.
+    """
+    current = threading.current_thread()
+    return sum(thread is not current and type(thread).__name__ != "TMonitor" for thread in threading.enumerate())
+
+
+class Forked:
+    """An array filled by a forked child process, in memory shared with this one.
+
+    The child calls ``fill(out, mark)``: it writes the array ``out`` (of ``shape`` and
+    ``dtype``) and may call ``mark(k)`` once its first k rows are final, so that `stop` can
+    keep them. It exits at once when done (``os._exit``: no ``atexit`` handlers, no buffers
+    flushed twice). Make one only where `can_fork` says yes. A child still running when
+    this process exits is killed.
+    """
+
+    def __init__(
+        self,
+        fill: Callable[[NDArray[Any], Callable[[int], None]], None],
+        shape: tuple[int, ...],
+        dtype: type[np.generic] = np.float64,
+    ) -> None:
+        self._shape, self._dtype = shape, np.dtype(dtype)
+        self._count = math.prod(shape)
+        # The count of final rows (8 bytes), then the array.
+        self._shared = mmap.mmap(-1, 8 + self._count * self._dtype.itemsize)
+        self._status: int | None = None
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child leaves by os._exit, invisible to coverage
+            global _in_child
+            _in_child = True
+            status = 1
+            try:
+                fill(self._view(), self._mark)
+                self._mark(shape[0])
+                status = 0
+            finally:
+                os._exit(status)
+        self.pid = pid
+        _children.add(self)
+
+    def _view(self) -> NDArray[Any]:
+        return np.frombuffer(self._shared, dtype=self._dtype, count=self._count, offset=8).reshape(self._shape)
+
+    def _mark(self, rows: int) -> None:
+        np.frombuffer(self._shared, dtype=np.int64, count=1)[0] = rows
+
+    def running(self) -> bool:
+        """Whether the child is still computing (without waiting for it)."""
+        if self._status is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                self._status = status
+        return self._status is None
+
+    def result(self) -> NDArray[Any] | None:
+        """Wait for the child: its array, or None if it failed."""
+        if self._status is None:
+            self._status = os.waitpid(self.pid, 0)[1]
+        out, _ = self._release()
+        return out if self._status == 0 else None
+
+    def stop(self) -> tuple[NDArray[Any], int]:
+        """The array and the count of its leading rows that are final, without waiting (a running child is stopped)."""
+        if self.running():
+            os.kill(self.pid, signal.SIGKILL)
+            self._status = os.waitpid(self.pid, 0)[1]
+        return self._release()
+
+    def _release(self) -> tuple[NDArray[Any], int]:
+        """The array and its count of final rows, copied out of the shared memory, which is then freed."""
+        _children.discard(self)
+        rows = int(np.frombuffer(self._shared, dtype=np.int64, count=1)[0])
+        out = self._view().copy()
+        self._shared.close()
+        return out, rows
+
+
+def in_two_processes(
+    compute: Callable[[slice], NDArray[Any]], size: int, dtype: type[np.generic] = np.float64
+) -> NDArray[Any]:
+    """``compute(slice(0, size))``, a 1-D array of ``dtype``, its second half computed by a forked child.
+
+    For pointwise work (each element depends only on its own inputs: NRLMSIS at a list of
+    points), so the two halves put together are the one call's result, bit for bit. Below
+    `FORK_MIN_POINTS` points, or where `can_fork` says no, one call here. Should the child
+    fail, this process computes its half too; on Ctrl-C or an error here the child is stopped.
+    """
+    if size < FORK_MIN_POINTS or not can_fork():
+        return compute(slice(0, size))
+    half = size // 2
+
+    def fill(out: NDArray[Any], _: Callable[[int], None]) -> None:
+        out[...] = compute(slice(half, size))
+
+    child = Forked(fill, (size - half,), dtype)
+    try:
+        first = compute(slice(0, half))
+    except BaseException:
+        child.stop()
+        raise
+    second = child.result()
+    return np.concatenate([first, compute(slice(half, size)) if second is None else second])
+
+
+#: This process's forked children not yet collected (`Forked`).
+_children: set[Forked] = set()
+#: True in a forked child: it forks no further.
+_in_child = False
+
+
+@atexit.register
+def _stop_children() -> None:
+    for child in list(_children):
+        child.stop()

@@ -2,6 +2,7 @@ import os
 import sys
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, settings
 
 # tests/ mirrors the package's folders; the helpers at its root (benchmark_scripts) are imported from any of them.
@@ -13,6 +14,10 @@ settings.register_profile("dev", deadline=None, max_examples=100)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
 
+#: The disk cache folder this run made (removed when it ends).
+_OWN_CACHE = pytest.StashKey[str]()
+
+
 def pytest_configure(config):
     # The tests read and write a disk cache of their own (the universal curves, NRLMSIS
     # profiles, DP solutions), not the user's: a run is not changed by what an earlier one
@@ -21,3 +26,30 @@ def pytest_configure(config):
         import tempfile
 
         os.environ["ORBIT_ENV_CACHE_DIR"] = tempfile.mkdtemp(prefix="orbit-env-tests-")
+        config.stash[_OWN_CACHE] = os.environ["ORBIT_ENV_CACHE_DIR"]
+
+
+def pytest_unconfigure(config):
+    # The cache made for this run goes with it (hundreds of MB of curves and DP tables a run).
+    folder = config.stash.get(_OWN_CACHE, None)
+    if folder is not None:
+        import shutil
+
+        # Off first: tables still held write themselves at exit (orbit_env.decay.daily_air), after this hook.
+        os.environ["ORBIT_ENV_CACHE_DIR"] = "off"
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture
+def forking(monkeypatch):
+    """Let this process hand work to forked children (`orbit_env.workers.can_fork`), or skip.
+
+    Skipped off Linux or on one core. The idle Python threads that earlier tests leave behind
+    (tensorboard's writers of the training tests) would forbid the fork; they never touch
+    what a child computes, so they are let be here (the guard itself is tested in test_workers.py).
+    """
+    from orbit_env import workers
+
+    monkeypatch.setattr(workers, "_other_threads", lambda: 0)
+    if not workers.can_fork():
+        pytest.skip("needs Linux and two cores")

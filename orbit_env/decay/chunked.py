@@ -295,10 +295,18 @@ class SolarDecayModel:
         return history
 
     def prefetch(self, daily: DailyIndices, t_days: float) -> None:
-        """Make sure the air table holds ``daily``; if not, it also computes the `PREFETCH_DAYS` from ``t_days``."""
+        """Make sure the air table holds ``daily``; if not, it also computes the `PREFETCH_DAYS` from ``t_days``.
+
+        The `PREFETCH_DAYS` after those are then computed by a forked process while the decay goes
+        on (`DailyAirTable.log_density`'s ``after``): on a cold run the next bin's curves and the
+        next half year's air are computed side by side.
+        """
         table = air_table(self.inclination_deg, self.ascending_node_local_time_h, self.version)
+        days = self.start_days + t_days + np.arange(2 * PREFETCH_DAYS, dtype=float)
         table.log_density(
-            daily, ahead=lambda: self.daily_indices(self.start_days + t_days + np.arange(PREFETCH_DAYS, dtype=float))
+            daily,
+            ahead=lambda: self.daily_indices(days[:PREFETCH_DAYS]),
+            after=lambda: self.daily_indices(days[PREFETCH_DAYS:]),
         )
 
     def log_ratios_by_day(self, first_day: int, count: int, binned: tuple[float, float]) -> FloatArray:

@@ -11,8 +11,12 @@ the same row serves every satellite, every date with the same indices, the shipp
 record, an imported table and the uncertainty's scaled forecasts alike.
 
 A row is computed the first time it is asked for, together with the rows of the days
-ahead the caller names (a year, one NRLMSIS call: about 0.6 s at 6 x 6 orbit samples and 23
-heights), and the table is written to the disk cache (`orbit_env.cache`, kind
+ahead the caller names (half a year, one NRLMSIS call, split over two processes where it may
+fork: `orbit_env.workers.in_two_processes`), while a forked process computes the days after
+those the caller names too (``after``; `orbit_env.workers.Forked`, 30 days at a time), taken
+in when the caller first asks for one of them: on a cold run the decay integrates a bin's
+curves meanwhile. A forked process still running then is stopped and its finished days
+kept; the caller computes the rest. The table is written to the disk cache (`orbit_env.cache`, kind
 ``"airdays"``) when it has grown by a quarter since it was last written, and when the
 process ends: a later run, in any process, reads it in milliseconds and calls NRLMSIS
 only for days it has never seen. (Written at every growth, the uncertainty's samples,
@@ -44,6 +48,7 @@ from numpy.typing import NDArray
 
 from orbit_env import cache
 from orbit_env.physics.atmosphere.msis import ap_histories, orbit_mean_density_by_day_kg_m3
+from orbit_env.workers import Forked, can_fork
 
 FloatArray = NDArray[np.float64]
 #: A day's indices as the decay rounds them: (F10.7 [sfu], 81-day mean [sfu], Ap, day of the year 1-366), then
@@ -53,6 +58,9 @@ DayKey = tuple[float, ...]
 DAILY_KEY = 4
 #: The 3-hourly ap a storm day's key holds: 57 h before its first slot to its last.
 STORM_AP_SLOTS = 27
+#: Days a forked process computes at a time (`DailyAirTable.log_density`'s ``after``): the rows it has finished
+#: are kept when it is stopped.
+BACKGROUND_PART = 30
 #: A table is written again when it holds this many times the rows it held when last written (or read).
 STORE_GROWTH = 1.25
 _TABLES: weakref.WeakSet[DailyAirTable] = weakref.WeakSet()
@@ -103,31 +111,48 @@ class DailyAirTable:
             self._keys, self._log_rho = stored["keys"], stored["log_density"]
         self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(_unpadded, self._keys.tolist()))}
         self._stored_rows = self._read_rows = len(self._row_of)
+        self._pending: tuple[list[DayKey], Forked] | None = None  # rows a forked process computes
         _TABLES.add(self)
 
     def __len__(self) -> int:
         """The number of days' indices held."""
         return len(self._row_of)
 
-    def log_density(self, keys: Sequence[DayKey], ahead: Callable[[], Sequence[DayKey]] | None = None) -> FloatArray:
+    def log_density(
+        self,
+        keys: Sequence[DayKey],
+        ahead: Callable[[], Sequence[DayKey]] | None = None,
+        after: Callable[[], Sequence[DayKey]] | None = None,
+    ) -> FloatArray:
         """The rows of ``keys``, shape (len(keys), heights): ln(density [kg/m^3]).
 
         Rows not held yet are computed in one NRLMSIS call with those of ``ahead()`` (the
-        days the caller will want next), and the table is written to the disk cache.
+        days the caller will want next); the rows of ``after()`` (the days after those) are
+        then computed by a forked process (`orbit_env.workers.Forked`, where it may fork)
+        while the caller goes on, and taken in at the next row not held.
         """
         rows = [self._row_of.get(key) for key in keys]
         if None in rows:
-            wanted = [key for key, row in zip(keys, rows, strict=True) if row is None]
-            if ahead is not None:
-                wanted += list(ahead())
-            self._add(wanted)
+            missing = [key for key, row in zip(keys, rows, strict=True) if row is None]
+            if self._pending_has(missing):
+                self._collect()
+                missing = [key for key in missing if key not in self._row_of]
+            if missing:
+                self._add([*missing, *(ahead() if ahead is not None else ())])
+            if after is not None:
+                self._start_background(after())
             rows = [self._row_of[key] for key in keys]
         return self._log_rho[rows]
 
     def _add(self, keys: Sequence[DayKey]) -> None:
         new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
+        if new:
+            self._append(*self._computed(new))
+
+    def _computed(self, new: list[DayKey]) -> tuple[list[DayKey], FloatArray]:
+        """The keys ``new`` (daily-Ap days first, then storm days) and their rows, by NRLMSIS."""
         # Daily-Ap days in one NRLMSIS call, storm days (longer keys) in another.
-        new.sort(key=len)
+        new = sorted(new, key=len)
         daily = sum(len(key) == DAILY_KEY for key in new)
         rho = np.empty((len(new), self.heights_m.size))
         for part, storm in ((slice(0, daily), False), (slice(daily, None), True)):
@@ -148,7 +173,35 @@ class DailyAirTable:
                 version=self.version,
                 ap_history=ap_histories(ap, values[:, DAILY_KEY:]) if storm else None,
             )
-        self._append(new, np.log(rho))
+        return new, np.log(rho)
+
+    def _start_background(self, keys: Sequence[DayKey]) -> None:
+        """Have a forked process compute the rows of ``keys`` not held (if this process may fork), a part at a time."""
+        new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
+        if not new or self._pending is not None or not can_fork():
+            return
+        new.sort(key=len)  # `_computed`'s order, so that each part keeps it
+
+        def fill(out: FloatArray, mark: Callable[[int], None]) -> None:
+            for start in range(0, len(new), BACKGROUND_PART):
+                stop = min(start + BACKGROUND_PART, len(new))
+                out[start:stop] = self._computed(new[start:stop])[1]
+                mark(stop)
+
+        self._pending = (new, Forked(fill, (len(new), self.heights_m.size)))
+
+    def _pending_has(self, keys: Sequence[DayKey]) -> bool:
+        """Whether the forked process computes one of ``keys``."""
+        return self._pending is not None and not set(keys).isdisjoint(self._pending[0])
+
+    def _collect(self) -> None:
+        """Hold the rows a forked process has computed so far (it is stopped if still running: no waiting for it)."""
+        if self._pending is not None:
+            keys, child = self._pending
+            self._pending = None
+            log_rho, done = child.stop()
+            if done:
+                self.merge(keys[:done], log_rho[:done])
 
     def _append(self, new: list[DayKey], log_rho: FloatArray) -> None:
         """Hold the rows ``log_rho`` of the keys ``new`` (none held yet); written when the table has grown enough."""
@@ -163,6 +216,11 @@ class DailyAirTable:
         self._row_of.update({key: start + k for k, key in enumerate(new)})
         if len(self) >= STORE_GROWTH * self._stored_rows:
             self.store()
+
+    def close(self) -> None:
+        """Keep the rows a forked process has finished (it is stopped if still running), and write the table."""
+        self._collect()
+        self.store()
 
     def settings(self) -> tuple[tuple[float, ...], float, float | None, float, int, int]:
         """The arguments of `daily_air_table` that give this table (in any process)."""
@@ -214,7 +272,7 @@ def merge_rows(rows: NewRows) -> None:
 @atexit.register
 def _store_all() -> None:
     for table in list(_TABLES):
-        table.store()
+        table.close()
 
 
 @lru_cache(maxsize=64)

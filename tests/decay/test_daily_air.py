@@ -7,6 +7,9 @@ Tolerance 1e-12 relative: the same NRLMSIS values summed in another order (a bat
 of days against one day; exp of the stored logarithm) differ in the last bits only.
 """
 
+import time
+from pathlib import Path
+
 import numpy as np
 import pymsis
 import pytest
@@ -208,3 +211,30 @@ def test_storm_days_are_those_whose_3_hourly_ap_reach_the_threshold():
         else:
             assert key == quiet  # a quiet day keeps its daily-Ap key: the same row as before
     assert 0 < sum(len(key) > 4 for key in storm) < len(storm)
+
+
+@pytest.mark.usefixtures("forking")
+def test_the_days_after_come_from_a_forked_process_and_equal_the_foreground_rows(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``after``'s rows are computed by a child (this process's NRLMSIS calls do not count them), bit for bit."""
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
+    heights = np.linspace(150e3, 600e3, 7)
+    keys = [(120.0 + day, 130.0, 8.0, 2.0 * day + 1.0) for day in range(12)]
+    calls = []
+    original = daily_air.orbit_mean_density_by_day_kg_m3
+    monkeypatch.setattr(
+        daily_air, "orbit_mean_density_by_day_kg_m3", lambda *a, **k: calls.append(1) or original(*a, **k)
+    )
+    table = daily_air.DailyAirTable(heights, 51.6, None, 2.1, 3, 3)
+    table.log_density(keys[:2], after=lambda: keys[2:])
+    assert len(calls) == 1  # the two days asked for; the ten after in the child
+    child = table._pending[1]
+    while child.running():  # asked for before it has finished, its unfinished days would be computed here
+        time.sleep(0.01)
+    later = table.log_density(keys[2:])
+    assert len(calls) == 1, "the days after were computed in this process"
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path / "other"))
+    fresh = daily_air.DailyAirTable(heights, 51.6, None, 2.1, 3, 3)
+    np.testing.assert_array_equal(later, fresh.log_density(keys[2:]))
+    assert len(calls) == 2

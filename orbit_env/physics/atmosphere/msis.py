@@ -74,6 +74,7 @@ from numpy.typing import ArrayLike, NDArray
 from orbit_env import cache
 from orbit_env.checks import check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M, EARTH_RADIUS_M
+from orbit_env.workers import in_two_processes
 
 FloatArray = NDArray[np.float64]
 
@@ -254,18 +255,25 @@ def _msis_density(
         storm = {"geomagnetic_activity": -1.0}
     else:
         histories, storm = np.repeat(per_point(ap_values)[:, None], 7, axis=1), {}
-    out = msis.calculate(
-        dates,
-        lons,
-        lats,
-        alts_km,
-        f107s=per_point(f107_sfu),
-        f107as=per_point(f107a_sfu),
-        aps=histories,
-        version=_pymsis_version(check_msis_version(version)),
-        **storm,
-    )
-    return np.asarray(out[..., 0], dtype=np.float64).reshape(shape)  # mass density, kg/m^3
+    f107s, f107as = per_point(f107_sfu), per_point(f107a_sfu)
+    name = _pymsis_version(check_msis_version(version))
+
+    def mass_density(part: slice) -> FloatArray:  # [kg/m^3] at the points of ``part``
+        out = msis.calculate(
+            dates[part],
+            lons[part],
+            lats[part],
+            alts_km[part],
+            f107s=f107s[part],
+            f107as=f107as[part],
+            aps=histories[part],
+            version=name,
+            **storm,
+        )
+        return np.asarray(out[..., 0], dtype=np.float64).ravel()
+
+    # Pointwise, so a large call is split over two processes (the cold path's most costly part).
+    return in_two_processes(mass_density, dates.size).reshape(shape)
 
 
 def mean_density_over_days_kg_m3(

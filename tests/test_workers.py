@@ -1,0 +1,84 @@
+"""`orbit_env.workers.in_two_processes`: a pointwise computation split with a forked child."""
+
+from __future__ import annotations
+
+import os
+import threading
+
+import numpy as np
+import pytest
+from tqdm import tqdm
+
+from orbit_env import workers
+from orbit_env.physics.atmosphere import msis
+
+POINTS = workers.FORK_MIN_POINTS + 11  # odd: the halves differ by one point
+
+
+def squares(part: slice) -> np.ndarray:
+    """The square of each point's index."""
+    return np.arange(part.start, part.stop, dtype=np.float64) ** 2
+
+
+def pids(part: slice) -> np.ndarray:
+    """The id of the process that computed each point."""
+    return np.full(part.stop - part.start, float(os.getpid()))
+
+
+@pytest.mark.usefixtures("forking")
+def test_the_second_half_is_computed_by_a_child_and_the_whole_is_the_one_calls_result() -> None:
+    np.testing.assert_array_equal(workers.in_two_processes(squares, POINTS), squares(slice(0, POINTS)))
+    by = workers.in_two_processes(pids, POINTS)
+    assert np.all(by[: POINTS // 2] == os.getpid())
+    assert np.all(by[POINTS // 2 :] != os.getpid()), "the second half was not computed by a child"
+
+
+@pytest.mark.usefixtures("forking")
+def test_a_failing_child_leaves_its_half_to_this_process() -> None:
+    parent = os.getpid()
+
+    def fails_in_a_child(part: slice) -> np.ndarray:
+        if os.getpid() != parent:
+            raise RuntimeError("child failure")
+        return pids(part)
+
+    assert np.all(workers.in_two_processes(fails_in_a_child, POINTS) == parent)
+
+
+def test_small_work_stays_in_this_process() -> None:
+    size = workers.FORK_MIN_POINTS - 1
+    np.testing.assert_array_equal(workers.in_two_processes(squares, size), squares(slice(0, size)))
+    assert np.all(workers.in_two_processes(pids, size) == os.getpid())
+
+
+def test_no_fork_beside_another_python_thread_but_tqdms_monitor() -> None:
+    """A thread of the user's forbids the fork; tqdm's monitor, which outlives its progress bars, does not."""
+    from tqdm.std import TMonitor
+
+    before = workers._other_threads()
+    stop = threading.Event()
+    thread = threading.Thread(target=stop.wait)
+    thread.start()
+    try:
+        assert workers._other_threads() == before + 1
+        assert not workers.can_fork()
+    finally:
+        stop.set()
+        thread.join()
+    monitor = TMonitor(tqdm, 10.0)  # started by its constructor, as tqdm does
+    try:
+        assert workers._other_threads() == before
+    finally:
+        monitor.exit()
+
+
+@pytest.mark.usefixtures("forking")
+def test_nrlmsis_split_over_two_processes_is_bit_for_bit_the_one_call(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The split changes nothing: NRLMSIS is pointwise, each half keeps the points' order."""
+    pytest.importorskip("pymsis")
+    heights = np.linspace(150e3, 700e3, 40)
+    args = (heights, 140.0 + np.arange(30.0), np.full(30, 150.0), np.full(30, 12.0), np.arange(30.0) * 12 + 1, 51.6)
+    split = msis.orbit_mean_density_by_day_kg_m3(*args)  # 30 days x 144 samples x 40 heights: above the threshold
+    assert 30 * 144 * 40 >= workers.FORK_MIN_POINTS
+    monkeypatch.setattr(workers, "FORK_MIN_POINTS", 10**9)
+    np.testing.assert_array_equal(msis.orbit_mean_density_by_day_kg_m3(*args), split)
