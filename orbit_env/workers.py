@@ -164,8 +164,9 @@ def in_two_processes(
 
     For pointwise work (each element depends only on its own inputs: NRLMSIS at a list of
     points), so the two halves put together are the one call's result, bit for bit. Below
-    `FORK_MIN_POINTS` points, or where `can_fork` says no, one call here. Should the child
-    fail, this process computes its half too; on Ctrl-C or an error here the child is stopped.
+    `FORK_MIN_POINTS` points, where `can_fork` says no or the fork fails, one call here. Should
+    the child fail, this process computes its half too; on Ctrl-C or an error here the child is
+    stopped.
     """
     if size < FORK_MIN_POINTS or not can_fork():
         return compute(slice(0, size))
@@ -174,7 +175,10 @@ def in_two_processes(
     def fill(out: NDArray[Any], _: Callable[[int], None]) -> None:
         out[...] = compute(slice(half, size))
 
-    child = Forked(fill, (size - half,), dtype)
+    try:
+        child = Forked(fill, (size - half,), dtype)
+    except OSError:  # no fork to be had (process or memory limits): all here
+        return compute(slice(0, size))
     try:
         first = compute(slice(0, half))
     except BaseException:

@@ -45,6 +45,16 @@ def test_a_failing_child_leaves_its_half_to_this_process() -> None:
     assert np.all(workers.in_two_processes(fails_in_a_child, POINTS) == parent)
 
 
+@pytest.mark.usefixtures("forking")
+def test_a_fork_refused_by_the_system_leaves_the_work_to_this_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refused() -> int:
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(os, "fork", refused)
+    np.testing.assert_array_equal(workers.in_two_processes(squares, POINTS), squares(slice(0, POINTS)))
+    assert not workers._children
+
+
 def test_small_work_stays_in_this_process() -> None:
     size = workers.FORK_MIN_POINTS - 1
     np.testing.assert_array_equal(workers.in_two_processes(squares, size), squares(slice(0, size)))

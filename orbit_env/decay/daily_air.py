@@ -188,7 +188,10 @@ class DailyAirTable:
                 out[start:stop] = self._computed(new[start:stop])[1]
                 mark(stop)
 
-        self._pending = (new, Forked(fill, (len(new), self.heights_m.size)))
+        try:
+            self._pending = (new, Forked(fill, (len(new), self.heights_m.size)))
+        except OSError:  # no fork to be had: the days are computed here when asked for
+            return
 
     def _pending_has(self, keys: Sequence[DayKey]) -> bool:
         """Whether the forked process computes one of ``keys``."""
