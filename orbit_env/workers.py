@@ -18,6 +18,7 @@ import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -48,16 +49,39 @@ def spawned_pool(processes: int, **kwargs: Any) -> Iterator[ProcessPoolExecutor]
     executor.shutdown()
 
 
+#: Set to "off" (or 0, false, no) to keep every computation in its process (no forked children).
+FORK_ENV_VAR = "ORBIT_ENV_FORK"
+
+
 def _cores() -> int:
-    """The cores this process may run on."""
+    """The cores this process may run on: its CPU affinity, within a container's CPU quota (cgroups)."""
     affinity = getattr(os, "sched_getaffinity", None)
-    return len(affinity(0)) if affinity is not None else os.cpu_count() or 1
+    cores = len(affinity(0)) if affinity is not None else os.cpu_count() or 1
+    quota = cgroup_cpu_limit()
+    return cores if quota is None else max(1, min(cores, math.ceil(quota)))
+
+
+def cgroup_cpu_limit(root: Path = Path("/sys/fs/cgroup")) -> float | None:
+    """The CPUs a container's quota allows (cgroup v2 ``cpu.max``, or v1 ``cpu.cfs_quota_us``), None if none."""
+    try:
+        v2 = root / "cpu.max"
+        if v2.is_file():
+            quota, period = v2.read_text().split()[:2]
+            return None if quota == "max" else int(quota) / int(period)
+        v1 = root / "cpu" / "cpu.cfs_quota_us"
+        if v1.is_file():
+            quota_us = int(v1.read_text())
+            return None if quota_us <= 0 else quota_us / int((root / "cpu" / "cpu.cfs_period_us").read_text())
+    except (OSError, ValueError):
+        return None
+    return None
 
 
 def can_fork() -> bool:
     """Whether a computation may be handed to a forked child here.
 
-    Linux only (fork elsewhere is unsafe or absent), at least two cores, and only in a
+    Not where `FORK_ENV_VAR` says off. Linux only (fork elsewhere is unsafe or absent), at
+    least two cores (`_cores`: a container's CPU quota counts), and only in a
     process that is neither a pool's worker nor a forked child, runs no other Python
     thread (a fork copies one thread: a lock another thread holds would never be released
     in the child; tqdm's monitor thread excepted, `_other_threads`) and has no worker
@@ -66,6 +90,7 @@ def can_fork() -> bool:
     """
     return (
         not _in_child
+        and os.environ.get(FORK_ENV_VAR, "").strip().lower() not in ("off", "0", "false", "no")
         and sys.platform.startswith("linux")
         and _cores() >= 2
         and multiprocessing.parent_process() is None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -92,3 +93,30 @@ def test_nrlmsis_split_over_two_processes_is_bit_for_bit_the_one_call(monkeypatc
     assert 30 * 144 * 40 >= workers.FORK_MIN_POINTS
     monkeypatch.setattr(workers, "FORK_MIN_POINTS", 10**9)
     np.testing.assert_array_equal(msis.orbit_mean_density_by_day_kg_m3(*args), split)
+
+
+def test_a_containers_cpu_quota_is_read_from_cgroups_v2_and_v1(tmp_path: Path) -> None:
+    assert workers.cgroup_cpu_limit(tmp_path) is None  # no cgroup files: no quota
+    (tmp_path / "cpu.max").write_text("max 100000\n")
+    assert workers.cgroup_cpu_limit(tmp_path) is None
+    (tmp_path / "cpu.max").write_text("150000 100000\n")  # docker --cpus=1.5
+    assert workers.cgroup_cpu_limit(tmp_path) == 1.5
+    v1 = tmp_path / "v1"
+    (v1 / "cpu").mkdir(parents=True)
+    (v1 / "cpu" / "cpu.cfs_quota_us").write_text("-1\n")
+    (v1 / "cpu" / "cpu.cfs_period_us").write_text("100000\n")
+    assert workers.cgroup_cpu_limit(v1) is None
+    (v1 / "cpu" / "cpu.cfs_quota_us").write_text("100000\n")
+    assert workers.cgroup_cpu_limit(v1) == 1.0
+    (tmp_path / "cpu.max").write_text("garbled")
+    assert workers.cgroup_cpu_limit(tmp_path) is None
+
+
+def test_one_cpu_of_quota_or_the_switch_keeps_the_work_here(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(workers, "_other_threads", lambda: 0)  # as the forking fixture: earlier tests' threads
+    monkeypatch.setattr(workers, "cgroup_cpu_limit", lambda: 1.0)
+    assert workers._cores() == 1 and not workers.can_fork()
+    monkeypatch.setattr(workers, "cgroup_cpu_limit", lambda: None)
+    monkeypatch.setenv(workers.FORK_ENV_VAR, "off")
+    assert not workers.can_fork()
+    assert np.all(workers.in_two_processes(pids, POINTS) == os.getpid())
