@@ -302,12 +302,11 @@ class SolarDecayModel:
         next half year's air are computed side by side.
         """
         table = air_table(self.inclination_deg, self.ascending_node_local_time_h, self.version)
-        days = self.start_days + t_days + np.arange(2 * PREFETCH_DAYS, dtype=float)
-        table.log_density(
-            daily,
-            ahead=lambda: self.daily_indices(days[:PREFETCH_DAYS]),
-            after=lambda: self.daily_indices(days[PREFETCH_DAYS:]),
-        )
+
+        def window(first: int) -> DailyIndices:  # the `PREFETCH_DAYS` from ``first`` days after ``t_days``
+            return self.daily_indices(self.start_days + t_days + (first + np.arange(PREFETCH_DAYS, dtype=float)))
+
+        table.log_density(daily, ahead=lambda: window(0), after=lambda: window(PREFETCH_DAYS))
 
     def log_ratios_by_day(self, first_day: int, count: int, binned: tuple[float, float]) -> FloatArray:
         """`log_ratio` of each of ``count`` days from ``first_day`` (days after the start), shape (days, heights).
