@@ -40,6 +40,9 @@ ENV_VAR = "ORBIT_ENV_CACHE_DIR"
 #: Bumped when the layout of a cached table changes.
 FORMAT_VERSION = 1
 
+#: Values of an ``ORBIT_ENV_*`` setting (this one, `orbit_env.workers.FORK_ENV_VAR`) that turn it off.
+OFF_SETTINGS = ("off", "0", "false", "no")
+
 _disabled = False
 
 
@@ -52,7 +55,7 @@ def disable() -> None:
 def cache_dir() -> Path | None:
     """The cache folder, or None when the cache is disabled."""
     setting = os.environ.get(ENV_VAR, "").strip()
-    if _disabled or setting.lower() in ("off", "0", "false", "no"):
+    if _disabled or setting.lower() in OFF_SETTINGS:
         return None
     if setting:
         return Path(setting).expanduser()

@@ -24,6 +24,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.cache import OFF_SETTINGS
+
 #: Points below which `in_two_processes` computes in this process alone: a fork costs a few milliseconds
 #: (measured 5-15 ms for a process with numpy and pymsis loaded), NRLMSIS 0.5-1 us a point.
 FORK_MIN_POINTS = 50_000
@@ -49,7 +51,7 @@ def spawned_pool(processes: int, **kwargs: Any) -> Iterator[ProcessPoolExecutor]
     executor.shutdown()
 
 
-#: Set to "off" (or 0, false, no) to keep every computation in its process (no forked children).
+#: Set to "off" (or 0, false, no: `orbit_env.cache.OFF_SETTINGS`) to keep every computation in its process.
 FORK_ENV_VAR = "ORBIT_ENV_FORK"
 
 
@@ -90,7 +92,7 @@ def can_fork() -> bool:
     """
     return (
         not _in_child
-        and os.environ.get(FORK_ENV_VAR, "").strip().lower() not in ("off", "0", "false", "no")
+        and os.environ.get(FORK_ENV_VAR, "").strip().lower() not in OFF_SETTINGS
         and sys.platform.startswith("linux")
         and _cores() >= 2
         and multiprocessing.parent_process() is None
