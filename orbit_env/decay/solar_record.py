@@ -281,15 +281,9 @@ def read_record(path: str | Path) -> RecordActivity:
     kind = np.array([r[4] for r in rows])
     ap3 = None
     if rows and len(rows[0]) == 6 and rows[0][5].count(",") >= 7:
-        tails = [r[5] for r in rows]
-        # Rows with all eight 3-hourly ap (observed days) at once; the others (forecasts) field by field.
-        complete = [",," not in t and not t.startswith(",") and not t.endswith(",") for t in tails]
-        ap3 = np.full((len(tails), 8), math.nan)
-        if any(complete):
-            full = [t for t, c in zip(tails, complete, strict=True) if c]
-            ap3[np.array(complete)] = np.loadtxt(full, delimiter=",", usecols=range(8), ndmin=2)
-        for i in (i for i, c in enumerate(complete) if not c):
-            ap3[i] = [float(v) if v else math.nan for v in tails[i].split(",")[:8]]
+        # The eight 3-hourly ap, empty where the record has none (forecasts): NaN.
+        tails = [",".join(v or "nan" for v in r[5].split(",")) for r in rows]
+        ap3 = np.loadtxt(tails, delimiter=",", usecols=range(8), dtype=np.float64, ndmin=2)
     return _record(days, values.T, kind, updated, files, source, ap3)
 
 
