@@ -20,8 +20,8 @@ from numpy.typing import NDArray
 
 from orbit_env.envs import solar_task
 from orbit_env.envs.config import OrbitRaisingConfig
-from orbit_env.envs.solar_task import SOLAR_CONFIG, SolarMission, SolarTask
-from orbit_env.envs.state import BatchState
+from orbit_env.envs.solar_task import SOLAR_CONFIG, SOLAR_OBS_NAMES, SolarMission, SolarTask
+from orbit_env.envs.state import ROW, BatchState
 
 FloatArray = NDArray[np.float64]
 
@@ -178,9 +178,10 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         state = self._state
         if state is None:
             raise RuntimeError("call reset() before step()")
-        result = solar_task.step(self.task, state, np.array([self.task.requested_dv(action)]))
-        self._dv_used_m_s += float(result.burn_m_s[0])
-        info: dict[str, Any] = {"burn_m_s": float(result.burn_m_s[0]), **self._outcome()}
+        result, obs = solar_task.step_and_observe(self.task, state, self.task.requested_dv(action))
+        burn = float(result.burn_m_s[0])
+        self._dv_used_m_s += burn
+        info: dict[str, Any] = {"burn_m_s": burn, **self._outcome()}
         truncated = bool(result.truncated[0])
         if truncated:
             info["disposal_dv_m_s"] = float(result.disposal_m_s[0])
@@ -188,21 +189,16 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._dv_used_m_s += info["disposal_dv_m_s"]
             info["dv_used_m_s"] = self._dv_used_m_s
         self._last = info
-        return (
-            solar_task.observe(self.task, state)[0],
-            float(result.reward[0]),
-            bool(result.terminated[0]),
-            truncated,
-            info,
-        )
+        return obs[0], float(result.reward[0]), bool(result.terminated[0]), truncated, info
 
     def _outcome(self) -> dict[str, Any]:
-        state = self._state
+        data = self._state.data  # a batch of one: column 0 (read directly, as the step is timed against CartPole's)
+        today = data[ROW.start_day, 0] + data[ROW.steps, 0] * self.task.mission.block_days
         return {
-            "reentered": bool(state.nu[0] <= 0.0),
-            "days_in_orbit": float(state.time_days[0]),
+            "reentered": bool(data[ROW.nu, 0] <= 0.0),
+            "days_in_orbit": float(data[ROW.time_days, 0]),
             "dv_used_m_s": self._dv_used_m_s,
-            "date": solar_task.date_of(self.task, float(solar_task.today(self.task, state)[0])),
+            "date": solar_task.date_of(self.task, float(today)),
         }
 
     def render(self) -> str | None:
@@ -291,12 +287,14 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         if restarting.size:  # NEXT_STEP: these ignore the action and start a new mission
             stepping = np.flatnonzero(~self._needs_reset)
             sub = state.take(stepping)
-            result = solar_task.step(self.task, sub, requested[stepping])
+            result, stepped_obs = solar_task.step_and_observe(self.task, sub, requested[stepping])
             state.put(stepping, sub)
-            self._restart(restarting)
+            obs = np.empty((n, len(SOLAR_OBS_NAMES)), dtype=np.float32)
+            obs[stepping] = stepped_obs
+            obs[restarting] = self._restart(restarting)
         else:
             stepping = slice(None)
-            result = solar_task.step(self.task, state, requested)
+            result, obs = solar_task.step_and_observe(self.task, state, requested)
         reward[stepping], terminated[stepping], truncated[stepping] = result.reward, result.terminated, result.truncated
         burn_m_s[stepping], disposal_m_s[stepping], complies[stepping] = (
             result.burn_m_s,
@@ -309,7 +307,6 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         info = {"burn_m_s": burn_m_s, "_burn_m_s": stepped, **self._outcome(np.ones(n, dtype=bool))}
         info["disposal_dv_m_s"], info["_disposal_dv_m_s"] = disposal_m_s, truncated.copy()
         info["complies"], info["_complies"] = complies, truncated.copy()
-        obs = solar_task.observe(self.task, state)
         if self.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP:
             done = np.flatnonzero(ends)
             if done.size:

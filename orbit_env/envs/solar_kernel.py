@@ -333,6 +333,52 @@ def _disposal_rows(
         )
 
 
+def _step_row(
+    data: FloatArray,
+    k: int,
+    requested_m_s: float,
+    p: FloatArray,
+    block_days: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> tuple[float, float, bool, bool]:
+    """A step of row ``k`` of a batch's state array, in place: the perigee burn asked for, then a month's `_coast`.
+
+    The burn is `orbit_env.envs.kernel.burn_row` (the known-density task's); the reward is the
+    days lived less the propellant's cost; the ends are re-entry and the horizon's step.
+
+    Returns:
+        (the burn made [m/s], the reward [days], terminated, truncated).
+    """
+    dv = 0.0
+    if min(requested_m_s, data[ROW.dv_left_m_s, k]) > 0.0:
+        dv = burn_row(data, k, requested_m_s, p, a_cells, a_grid, b_cells, b_grid)
+    gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
+    day = data[ROW.start_day, k] + data[ROW.steps, k] * block_days
+    perigee, apogee = data[ROW.perigee_m, k], data[ROW.apogee_m, k]
+    lived, nu, tau, hp, ha, period, ratio = _coast(
+        data[ROW.label, k], data[ROW.nu, k], perigee, apogee, gc, day, block_days, b_cells, b_grid, cumulative
+    )
+    data[ROW.perigee_drop_m, k] = perigee - hp
+    data[ROW.apogee_drop_m, k] = apogee - ha
+    data[ROW.nu, k] = nu
+    data[ROW.tau, k] = tau
+    data[ROW.perigee_m, k] = hp
+    data[ROW.apogee_m, k] = ha
+    if nu > 0.0:
+        data[ROW.period_s, k] = period  # a re-entered orbit keeps its last period
+    data[SEGMENT_ROW, k] = STALE_SEGMENT  # the known-density task's kept cell: not this task's
+    data[ROW.density_scale, k] = ratio
+    data[ROW.time_days, k] += lived
+    steps = data[ROW.steps, k] + 1.0
+    data[ROW.steps, k] = steps
+    reward = lived - p[PARAMETERS.propellant_cost_per_m_s] * dv
+    return dv, reward, nu <= 0.0, steps >= p[PARAMETERS.horizon_steps] and nu > 0.0
+
+
 def _step_rows(
     data: FloatArray,
     requested_m_s: FloatArray,
@@ -347,40 +393,55 @@ def _step_rows(
     reward: FloatArray,
     terminated: NDArray[np.bool_],
     truncated: NDArray[np.bool_],
-) -> None:
-    """A step of every row of a batch's state array, in place: the perigee burn asked for, then a month's `_coast`.
-
-    The burn is `orbit_env.envs.kernel.burn_row` (the known-density task's); the reward is the
-    days lived less the propellant's cost; the ends are re-entry and the horizon's step.
-    """
-    cost, horizon = p[PARAMETERS.propellant_cost_per_m_s], p[PARAMETERS.horizon_steps]
+) -> int:
+    """`_step_row` of every row of a batch's state array, in place; returns how many rows were truncated."""
+    ending = 0
     for k in range(data.shape[1]):
-        dv = 0.0
-        if min(requested_m_s[k], data[ROW.dv_left_m_s, k]) > 0.0:
-            dv = burn_row(data, k, requested_m_s[k], p, a_cells, a_grid, b_cells, b_grid)
-        gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
-        day = data[ROW.start_day, k] + data[ROW.steps, k] * block_days
-        perigee, apogee = data[ROW.perigee_m, k], data[ROW.apogee_m, k]
-        lived, nu, tau, hp, ha, period, ratio = _coast(
-            data[ROW.label, k], data[ROW.nu, k], perigee, apogee, gc, day, block_days, b_cells, b_grid, cumulative
+        made[k], reward[k], terminated[k], truncated[k] = _step_row(
+            data, k, requested_m_s[k], p, block_days, a_cells, a_grid, b_cells, b_grid, cumulative
         )
-        data[ROW.perigee_drop_m, k] = perigee - hp
-        data[ROW.apogee_drop_m, k] = apogee - ha
-        data[ROW.nu, k] = nu
-        data[ROW.tau, k] = tau
-        data[ROW.perigee_m, k] = hp
-        data[ROW.apogee_m, k] = ha
-        if nu > 0.0:
-            data[ROW.period_s, k] = period  # a re-entered orbit keeps its last period
-        data[SEGMENT_ROW, k] = STALE_SEGMENT  # the known-density task's kept cell: not this task's
-        data[ROW.density_scale, k] = ratio
-        data[ROW.time_days, k] += lived
-        steps = data[ROW.steps, k] + 1.0
-        data[ROW.steps, k] = steps
-        made[k] = dv
-        reward[k] = lived - cost * dv
-        terminated[k] = nu <= 0.0
-        truncated[k] = steps >= horizon and nu > 0.0
+        ending += truncated[k]
+    return ending
+
+
+def _observe_row(
+    data: FloatArray,
+    k: int,
+    p: FloatArray,
+    block_days: float,
+    index_scale: float,
+    indices: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+    obs: NDArray[np.float32],
+) -> None:
+    """The observation of row ``k`` into ``obs[k]``: the orbit, tank, clock, predicted life; the Sun yesterday.
+
+    The predicted life is W over the last span's mean multiplier at the perigee; the Sun's
+    indices (``indices`` rows: F10.7, its 81- and 365-day means, Ap) are the day's before the
+    step's first, over ``index_scale``; each component clipped to [low, high].
+    """
+    steps = data[ROW.steps, k]
+    yesterday = int(data[ROW.start_day, k] + steps * block_days - 1.0)
+    gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
+    life = data[ROW.period_s, k] * data[ROW.nu, k] / (gc * max(data[ROW.density_scale, k], 1e-9) * SECONDS_PER_DAY)
+    apogee_drop = max(data[ROW.apogee_drop_m, k], 0.0)
+    perigee_drop = max(data[ROW.perigee_drop_m, k], 0.0)
+    values = (
+        data[ROW.perigee_m, k] * p[PARAMETERS.per_height_scale_m],
+        data[ROW.apogee_m, k] * p[PARAMETERS.per_height_scale_m],
+        data[ROW.dv_left_m_s, k] * p[PARAMETERS.per_dv_scale_m_s],
+        min(steps / p[PARAMETERS.horizon_steps], 1.0),
+        life / (life + p[PARAMETERS.lifetime_scale_days]),
+        apogee_drop / (apogee_drop + p[PARAMETERS.apogee_drop_scale_m]),
+        perigee_drop / (perigee_drop + p[PARAMETERS.perigee_drop_scale_m]),
+        indices[0, yesterday] / index_scale,
+        indices[1, yesterday] / index_scale,
+        indices[2, yesterday] / index_scale,
+        indices[3, yesterday] / index_scale,
+    )
+    for m in range(len(values)):
+        obs[k, m] = min(max(values[m], low[m]), high[m])
 
 
 def _observe_rows(
@@ -393,34 +454,44 @@ def _observe_rows(
     high: FloatArray,
     obs: NDArray[np.float32],
 ) -> None:
-    """The observation of every row into ``obs`` (n, 11): the orbit, tank, clock, predicted life; the Sun yesterday.
-
-    The predicted life is W over the last span's mean multiplier at the perigee; the Sun's
-    indices (``indices`` rows: F10.7, its 81- and 365-day means, Ap) are the day's before the
-    step's first, over ``index_scale``; each component clipped to [low, high].
-    """
+    """`_observe_row` of every row into ``obs`` (n, 11)."""
     for k in range(data.shape[1]):
-        steps = data[ROW.steps, k]
-        yesterday = int(data[ROW.start_day, k] + steps * block_days - 1.0)
-        gc = G0_M_S2 * (data[ROW.drag_area_m2, k] / data[ROW.mass_kg, k])
-        life = data[ROW.period_s, k] * data[ROW.nu, k] / (gc * max(data[ROW.density_scale, k], 1e-9) * SECONDS_PER_DAY)
-        apogee_drop = max(data[ROW.apogee_drop_m, k], 0.0)
-        perigee_drop = max(data[ROW.perigee_drop_m, k], 0.0)
-        values = (
-            data[ROW.perigee_m, k] * p[PARAMETERS.per_height_scale_m],
-            data[ROW.apogee_m, k] * p[PARAMETERS.per_height_scale_m],
-            data[ROW.dv_left_m_s, k] * p[PARAMETERS.per_dv_scale_m_s],
-            min(steps / p[PARAMETERS.horizon_steps], 1.0),
-            life / (life + p[PARAMETERS.lifetime_scale_days]),
-            apogee_drop / (apogee_drop + p[PARAMETERS.apogee_drop_scale_m]),
-            perigee_drop / (perigee_drop + p[PARAMETERS.perigee_drop_scale_m]),
-            indices[0, yesterday] / index_scale,
-            indices[1, yesterday] / index_scale,
-            indices[2, yesterday] / index_scale,
-            indices[3, yesterday] / index_scale,
+        _observe_row(data, k, p, block_days, index_scale, indices, low, high, obs)
+
+
+def _step_observe_rows(
+    data: FloatArray,
+    requested_m_s: FloatArray,
+    p: FloatArray,
+    block_days: float,
+    index_scale: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    indices: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+    made: FloatArray,
+    reward: FloatArray,
+    terminated: NDArray[np.bool_],
+    truncated: NDArray[np.bool_],
+    obs: NDArray[np.float32],
+) -> int:
+    """`_step_row`, then `_observe_row`, of every row (what an environment's step does in one call).
+
+    Returns:
+        How many rows were truncated (the mission's end: their rule is judged next).
+    """
+    ending = 0
+    for k in range(data.shape[1]):
+        made[k], reward[k], terminated[k], truncated[k] = _step_row(
+            data, k, requested_m_s[k], p, block_days, a_cells, a_grid, b_cells, b_grid, cumulative
         )
-        for m in range(len(values)):
-            obs[k, m] = min(max(values[m], low[m]), high[m])
+        ending += truncated[k]
+        _observe_row(data, k, p, block_days, index_scale, indices, low, high, obs)
+    return ending
 
 
 class _Loops(NamedTuple):
@@ -431,9 +502,10 @@ class _Loops(NamedTuple):
     disposal_rows: Any
     step_rows: Any
     observe_rows: Any
+    step_observe_rows: Any
 
 
-_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows, _step_rows, _observe_rows)
+_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows, _step_rows, _observe_rows, _step_observe_rows)
 
 
 @lru_cache(maxsize=1)
@@ -444,7 +516,7 @@ def loops() -> _Loops:
     import numba
 
     kernel_loops()  # registers the known-density loops' helpers (burn_row and what it calls)
-    helpers = (drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast)
+    helpers = (drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast, _step_row, _observe_row)
     for helper in (*helpers, _life_margin, _candidate_margin, _disposal_perigee):
         numba.extending.register_jitable(helper)
     return _Loops(*(numba.njit(cache=True, nogil=True)(loop) for loop in _PLAIN))
@@ -529,15 +601,15 @@ def step_rows(
     requested_m_s: FloatArray,
     parameters: FloatArray,
     block_days: float,
-) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
-    """`_step_rows` of every row of a batch's state array: (burns made, reward, terminated, truncated)."""
+) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_], int]:
+    """`_step_rows` of a batch's state array: (burns made, reward, terminated, truncated, how many truncated)."""
     n = data.shape[1]
     made, reward = np.empty(n), np.empty(n)
     terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
     requested = np.asarray(requested_m_s, dtype=np.float64)
     if requested.shape != (n,):
         requested = np.full(n, float(requested))
-    loops().step_rows(
+    ending = loops().step_rows(
         data,
         requested,
         parameters,
@@ -552,7 +624,47 @@ def step_rows(
         terminated,
         truncated,
     )
-    return made, reward, terminated, truncated
+    return made, reward, terminated, truncated, ending
+
+
+def step_observe_rows(
+    t: SolarTables,
+    data: FloatArray,
+    requested_m_s: FloatArray,
+    parameters: FloatArray,
+    block_days: float,
+    index_scale: float,
+    bounds: FloatArray,
+) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.float32]]:
+    """`_step_observe_rows` of a batch's state array: `step_rows`'s five, then the observations (n, components)."""
+    n = data.shape[1]
+    made, reward = np.empty(n), np.empty(n)
+    terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+    obs = np.empty((n, bounds.shape[1]), dtype=np.float32)
+    requested = np.asarray(requested_m_s, dtype=np.float64)
+    if requested.shape != (n,):
+        requested = np.full(n, float(requested))
+    ending = loops().step_observe_rows(
+        data,
+        requested,
+        parameters,
+        float(block_days),
+        float(index_scale),
+        t.a_cells,
+        t.a_grid,
+        t.b_cells,
+        t.b_grid,
+        t.cumulative,
+        t.indices,
+        bounds[0],
+        bounds[1],
+        made,
+        reward,
+        terminated,
+        truncated,
+        obs,
+    )
+    return made, reward, terminated, truncated, ending, obs
 
 
 def observe_rows(

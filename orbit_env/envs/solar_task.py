@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
-from functools import cached_property
+from functools import cached_property, lru_cache
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -408,24 +408,56 @@ def step(task: SolarTask, state: BatchState, requested_dv_m_s: Any) -> SolarStep
         The reward (days in orbit during the step, minus ``propellant_cost_per_m_s`` times the
         burn, and at the end times the disposal burn, or the penalty), the ends and the burns.
     """
-    dv, reward, terminated, truncated = solar_kernel.step_rows(
+    moved = solar_kernel.step_rows(
         task.tables, state.data, requested_dv_m_s, task.kernel_parameters, float(task.mission.block_days)
     )
-    cost = task.config.propellant_cost_per_m_s
+    return _rule_at_the_end(task, state, *moved)
+
+
+def step_and_observe(
+    task: SolarTask, state: BatchState, requested_dv_m_s: Any
+) -> tuple[SolarStep, NDArray[np.float32]]:
+    """`step`, then `observe`, in one compiled loop over the orbits: what an environment's step does."""
+    *moved, ending, obs = solar_kernel.step_observe_rows(
+        task.tables,
+        state.data,
+        requested_dv_m_s,
+        task.kernel_parameters,
+        float(task.mission.block_days),
+        SOLAR_INDEX_SCALE,
+        _BOUNDS,
+    )
+    result = _rule_at_the_end(task, state, *moved, ending)
+    if ending:  # the disposal burn spent propellant: observed again
+        rows = np.flatnonzero(result.truncated)
+        obs[rows] = observe(task, state.take(rows))
+    return result, obs
+
+
+def _rule_at_the_end(
+    task: SolarTask,
+    state: BatchState,
+    dv: FloatArray,
+    reward: FloatArray,
+    terminated: NDArray[np.bool_],
+    truncated: NDArray[np.bool_],
+    ending: int,
+) -> SolarStep:
+    """A step's result, the ``ending`` missions (the truncated) judged by the rule: disposal burn or penalty."""
     disposal_m_s = np.zeros(state.size)
     complies = np.ones(state.size, dtype=bool)
-    ending = np.flatnonzero(truncated)
-    if ending.size:
-        ended = state.take(ending)
+    if ending:
+        rows = np.flatnonzero(truncated)
+        ended = state.take(rows)
         need, able = disposal(task, ended)
         made = np.where(able, need, 0.0)
         ended.mass_kg = ended.mass_kg / np.exp(made / ended.exhaust_m_s)
         ended.mass_kg = np.maximum(ended.mass_kg, ended.dry_mass_kg)
         update_satellite(task, ended)
-        state.put(ending, ended)
-        disposal_m_s[ending] = made
-        complies[ending] = able
-        reward[ending] -= cost * made + np.where(able, 0.0, task.penalty_days)
+        state.put(rows, ended)
+        disposal_m_s[rows] = made
+        complies[rows] = able
+        reward[rows] -= task.config.propellant_cost_per_m_s * made + np.where(able, 0.0, task.penalty_days)
     return SolarStep(reward, terminated, truncated, dv, disposal_m_s, complies)
 
 
@@ -448,8 +480,19 @@ def observe(task: SolarTask, state: BatchState) -> NDArray[np.float32]:
 
 
 def date_of(task: SolarTask, day: float) -> str:
-    """ISO date of a clock day."""
+    """ISO date of a clock day (a whole day's from a list made once per clock: a step's ``info["date"]``)."""
+    k = int(day)
+    dates = _iso_dates(task.clock)
+    if k == day and 0 <= k < len(dates):
+        return dates[k]
     return iso_date(task.clock.start_days + float(day))
+
+
+@lru_cache(maxsize=4)
+def _iso_dates(clock: DragClock) -> list[str]:
+    """`iso_date` of every whole day of a clock, in order."""
+    first = np.datetime64(math.floor(clock.start_days), "D")
+    return np.datetime_as_string(first + np.arange(clock.days)).tolist()
 
 
 def dates_of(task: SolarTask, days: FloatArray) -> NDArray[np.datetime64]:

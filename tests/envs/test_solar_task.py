@@ -119,6 +119,23 @@ def test_the_compiled_loops_are_the_plain_functions(monkeypatch: pytest.MonkeyPa
     assert np.any(compiled[2] < state.perigee_m)  # some need a disposal burn: the search ran
 
 
+def test_step_and_observe_is_step_then_observe() -> None:
+    # The environments' one compiled call against the two it fuses, on missions some of which end in the
+    # step (the rule judged, the disposal burn charged, those rows observed again): the same numbers, bit for bit.
+    task = TEST_TASK
+    state, _, _ = _random_orbits(40, 11)
+    state.steps = np.where(np.arange(state.size) % 3 == 0, task.config.horizon_steps - 1.0, 5.0)
+    requested = np.resize(task.burn_sizes_m_s, state.size)
+    apart = state.take(np.arange(state.size))
+    fused, obs = st.step_and_observe(task, state, requested)
+    result = st.step(task, apart, requested)
+    assert fused.truncated.sum() > 5 and np.any(fused.disposal_m_s > 0.0)  # the rule's path ran
+    for name in fused._fields:
+        np.testing.assert_array_equal(getattr(fused, name), getattr(result, name), err_msg=name)
+    np.testing.assert_array_equal(state.data, apart.data)
+    np.testing.assert_array_equal(obs, st.observe(task, apart))
+
+
 def _drag_clock_life(hp_km: float, ha_km: float, date: str) -> float:
     """Days to re-entry of the 210 kg, 1 m^2 satellite by the task's monthly coasts."""
     task = TEST_TASK
