@@ -185,17 +185,22 @@ class Forked:
 
 
 def in_two_processes(
-    compute: Callable[[slice], NDArray[Any]], size: int, dtype: type[np.generic] = np.float64
+    compute: Callable[[slice], NDArray[Any]],
+    size: int,
+    dtype: type[np.generic] = np.float64,
+    *,
+    row_shape: tuple[int, ...] = (),
+    min_size: int = FORK_MIN_POINTS,
 ) -> NDArray[Any]:
-    """``compute(slice(0, size))``, a 1-D array of ``dtype``, its second half computed by a forked child.
+    """``compute(slice(0, size))``: an array (size, *row_shape) of ``dtype``, its second half by a forked child.
 
-    For pointwise work (each element depends only on its own inputs: NRLMSIS at a list of
-    points), so the two halves put together are the one call's result, bit for bit. Below
-    `FORK_MIN_POINTS` points, where `can_fork` says no or the fork fails, one call here. Should
-    the child fail, this process computes its half too; on Ctrl-C or an error here the child is
-    stopped.
+    For work whose rows are independent (each depends only on its own inputs: NRLMSIS at a list
+    of points, a universal curve), so the two halves put together are the one call's result,
+    bit for bit. Below ``min_size`` rows (`FORK_MIN_POINTS`), where `can_fork` says no or the
+    fork fails, one call here. Should the child fail, this process computes its half too; on
+    Ctrl-C or an error here the child is stopped.
     """
-    if size < FORK_MIN_POINTS or not can_fork():
+    if size < min_size or not can_fork():
         return compute(slice(0, size))
     half = size // 2
 
@@ -203,7 +208,7 @@ def in_two_processes(
         out[...] = compute(slice(half, size))
 
     try:
-        child = Forked(fill, (size - half,), dtype)
+        child = Forked(fill, (size - half, *row_shape), dtype)
     except OSError:  # no fork to be had (process or memory limits): all here
         return compute(slice(0, size))
     try:

@@ -56,6 +56,22 @@ def test_a_fork_refused_by_the_system_leaves_the_work_to_this_process(monkeypatc
     assert not workers._children
 
 
+@pytest.mark.usefixtures("forking")
+def test_rows_of_several_values_are_split_as_rows() -> None:
+    """``row_shape``: each row (here a point's pid and its square, twice) is computed whole on one side."""
+
+    def rows(part: slice) -> np.ndarray:
+        index = np.arange(part.start, part.stop, dtype=np.float64)
+        pid = np.full(index.size, float(os.getpid()))
+        values = np.stack([index**2, pid], axis=1)  # (rows, 2)
+        return np.stack([values, values], axis=1)  # (rows, 2, 2)
+
+    by = workers.in_two_processes(rows, 9, row_shape=(2, 2), min_size=2)
+    assert by.shape == (9, 2, 2)
+    np.testing.assert_array_equal(by[:, :, 0], np.repeat(np.arange(9.0)[:, None] ** 2, 2, axis=1))
+    assert np.all(by[:4, :, 1] == os.getpid()) and np.all(by[4:, :, 1] != os.getpid())
+
+
 def test_small_work_stays_in_this_process() -> None:
     size = workers.FORK_MIN_POINTS - 1
     np.testing.assert_array_equal(workers.in_two_processes(squares, size), squares(slice(0, size)))

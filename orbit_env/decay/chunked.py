@@ -107,6 +107,10 @@ PREFETCH_DAYS = 180
 #: Measured: docs/validation-modern/solar-activity.md, section "Storm days".
 STORM_AP = 48.0
 
+#: Heights of `RATIO_GRID_M` above the highest one a decay's orbits reach whose air it still needs: the
+#: interpolation's upper neighbour and its gradient's (`SolarDecayModel.air_columns`).
+AIR_COLUMNS_ABOVE = 2
+
 DailyIndices = tuple[tuple[float, ...], ...]
 
 
@@ -146,8 +150,9 @@ def _log_ratio(
     inclination_deg: float,
     ascending_node_local_time_h: float | None,
     version: float,
+    columns: int | None,
 ) -> FloatArray:
-    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily)
+    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily, columns=columns)
     return np.log(np.exp(log_rho).mean(axis=0)) - _log_bin_density(
         binned, inclination_deg, ascending_node_local_time_h, version
     )
@@ -161,9 +166,10 @@ def _log_ratios_by_day(
     inclination_deg: float,
     ascending_node_local_time_h: float | None,
     version: float,
+    columns: int | None,
 ) -> FloatArray:
     """`_log_ratio` of each day of ``daily`` (``per_day`` rows each): shape (days, heights)."""
-    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily)
+    log_rho = air_table(inclination_deg, ascending_node_local_time_h, version).log_density(daily, columns=columns)
     rho_days = np.exp(log_rho).reshape(-1, per_day, log_rho.shape[1]).mean(axis=1)
     bin_log_rho = _log_bin_density(binned, inclination_deg, ascending_node_local_time_h, version)
     return np.log(rho_days) - bin_log_rho[None, :]
@@ -203,6 +209,9 @@ class SolarDecayModel:
         storm_ap: On storm days (`STORM_AP`) of an activity that has the 3-hourly ap
             (``activity.ap_history``, the CelesTrak record's), NRLMSIS in its storm-time mode
             (`daily_indices`); False: the daily Ap every day.
+        air_top_m: The highest height [m] the orbits decayed on this model reach (`propagate`
+            sets it from their apogees; None: any). The days' air is then computed up to it
+            only (`air_columns`): the ratios hold NaN above, where no orbit reads them.
     """
 
     activity: SolarActivity
@@ -218,6 +227,7 @@ class SolarDecayModel:
     max_years: float = DEFAULT_MAX_YEARS
     version: float = DEFAULT_MSIS_VERSION
     storm_ap: bool = True
+    air_top_m: float | None = None
     _bins: dict[tuple[float, float], DecayModel] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -226,6 +236,17 @@ class SolarDecayModel:
         check_number(self.max_years, "max_years", unit="years", low=0.0, high=1000.0, low_inclusive=False)
         check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
         object.__setattr__(self, "version", check_msis_version(self.version))
+
+    def air_columns(self) -> int | None:
+        """How many heights of `RATIO_GRID_M` from the lowest the days' air needs (None: all of them).
+
+        Those up to `air_top_m`, and `AIR_COLUMNS_ABOVE` more: an orbit's density ratio is
+        interpolated between two heights, its slope from a central difference.
+        """
+        if self.air_top_m is None:
+            return None
+        below = int(np.searchsorted(RATIO_GRID_M, self.air_top_m, side="right"))
+        return below + AIR_COLUMNS_ABOVE if below + AIR_COLUMNS_ABOVE < RATIO_GRID_M.size else None
 
     def chunk_condition(self, t_days: float) -> tuple[DailyIndices, tuple[float, float]]:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""
@@ -306,7 +327,9 @@ class SolarDecayModel:
         def window(first: int) -> DailyIndices:  # the `PREFETCH_DAYS` from ``first`` days after ``t_days``
             return self.daily_indices(self.start_days + t_days + (first + np.arange(PREFETCH_DAYS, dtype=float)))
 
-        table.log_density(daily, ahead=lambda: window(0), after=lambda: window(PREFETCH_DAYS))
+        table.log_density(
+            daily, ahead=lambda: window(0), after=lambda: window(PREFETCH_DAYS), columns=self.air_columns()
+        )
 
     def log_ratios_by_day(self, first_day: int, count: int, binned: tuple[float, float]) -> FloatArray:
         """`log_ratio` of each of ``count`` days from ``first_day`` (days after the start), shape (days, heights).
@@ -324,11 +347,19 @@ class SolarDecayModel:
             float(self.inclination_deg),
             self.ascending_node_local_time_h,
             self.version,
+            self.air_columns(),
         )
 
     def log_ratio(self, daily: DailyIndices, binned: tuple[float, float]) -> FloatArray:
-        """ln(the mean density over ``daily`` / the bin's) on `RATIO_GRID_M` (cached)."""
-        return _log_ratio(daily, binned, float(self.inclination_deg), self.ascending_node_local_time_h, self.version)
+        """ln(the mean density over ``daily`` / the bin's) on `RATIO_GRID_M` (cached; NaN above `air_columns`)."""
+        return _log_ratio(
+            daily,
+            binned,
+            float(self.inclination_deg),
+            self.ascending_node_local_time_h,
+            self.version,
+            self.air_columns(),
+        )
 
     def bin_model(self, binned: tuple[float, float]) -> DecayModel:
         """The decay model of a bin (its atmosphere: NRLMSIS at the binned indices, year-averaged)."""
@@ -728,6 +759,8 @@ def _propagate(
 ) -> SolarLifetime:
     """`propagate` on the bins of ``model`` for every satellite."""
     hp, ha = hp.copy(), ha.copy()
+    if ha.size:  # decaying orbits only come down: the days' air above their highest apogee is never read
+        model = replace(model, air_top_m=float(np.max(ha)))
     n = hp.size
     gcs = G0_M_S2 * c * scale
     spread = _Spread.of(model, inclination_deg, hp, ha)

@@ -48,6 +48,7 @@ from orbit_env.checks import check_array
 from orbit_env.constants import EARTH_RADIUS_M, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.physics.orbit import elements_from_heights, period_s, validate_heights, validate_heights_km
+from orbit_env.workers import in_two_processes
 
 FloatArray = NDArray[np.float64]
 
@@ -577,13 +578,30 @@ class UniversalCurves:
         return np.stack([-dhp_dnu, -de_dnu / e, period_s(p, e)]) * dnu_dtau
 
     def _integrate(self, tau: FloatArray, labels: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """RK4 in tau, backward from re-entry, all curves at once.
+        """RK4 in tau, backward from re-entry, all curves at once (half of them in a forked process, if it may).
 
         tau, not the perigee height, is the variable: elongated orbits lose apogee
         at an almost constant perigee, where the curves stand nearly vertical.
         Returns perigee height, ln(e) and W on the tau grid, NaN once a curve has
-        left the domain.
+        left the domain. Each curve's steps are its own (numpy's element-wise operations
+        and a sum over each orbit's anomalies), so the curves integrated in two groups
+        are the curves integrated together, bit for bit; every other curve goes to each
+        group, as the eccentric ones leave the domain sooner (each half takes 0.6 of the whole's time).
         """
+        # The model's air tables built here, once, before the fork (else each process would build them).
+        self.model.rates_per_nu(np.array([EARTH_RADIUS_M + REENTRY_ALTITUDE_M]), np.array([0.0]))
+        order = np.concatenate([np.arange(0, labels.size, 2), np.arange(1, labels.size, 2)])
+
+        def part(curves: slice) -> FloatArray:
+            return np.stack(self._integrate_curves(tau, labels[order[curves]]), axis=1)
+
+        together = in_two_processes(part, labels.size, row_shape=(3, tau.size), min_size=2)
+        out = np.empty_like(together)
+        out[order] = together
+        return out[:, 0], out[:, 1], out[:, 2]
+
+    def _integrate_curves(self, tau: FloatArray, labels: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """`_integrate` of the curves ``labels``, in this process."""
         n_curves = labels.size
         out = np.full((3, n_curves, tau.size), np.nan)
         state = np.stack([np.full(n_curves, REENTRY_ALTITUDE_M), labels, np.zeros(n_curves)])

@@ -22,7 +22,9 @@ process ends: a later run, in any process, reads it in milliseconds and calls NR
 only for days it has never seen. (Written at every growth, the uncertainty's samples,
 whose scaled forecasts are days never seen, rewrote a growing table hundreds of times.)
 The rows are NRLMSIS's own values for those indices (a memo, not an interpolation), so
-results do not change with what is cached. Worker processes (the uncertainty's solar
+results do not change with what is cached. A caller may ask for the first heights only
+(``columns``: a decay reads no air above its orbits): a row is then computed to those heights,
+NaN above, and deepened when a later caller asks for more. Worker processes (the uncertainty's solar
 nodes) hand the rows they computed back to their parent (`new_rows`, `merge_rows`), which
 writes them with its own: two processes writing one table would keep only one's rows.
 Units: SI (m, kg/m^3).
@@ -110,7 +112,9 @@ class DailyAirTable:
         else:
             self._keys, self._log_rho = stored["keys"], stored["log_density"]
         self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(_unpadded, self._keys.tolist()))}
+        self._columns = _computed_columns(self._log_rho)  # per row: its leading columns NRLMSIS has filled
         self._stored_rows = self._read_rows = len(self._row_of)
+        self._changes = 0  # rows added or deepened since the table was last written (or read)
         self._pending: tuple[list[DayKey], Forked] | None = None  # rows a forked process computes
         _TABLES.add(self)
 
@@ -123,45 +127,58 @@ class DailyAirTable:
         keys: Sequence[DayKey],
         ahead: Callable[[], Sequence[DayKey]] | None = None,
         after: Callable[[], Sequence[DayKey]] | None = None,
+        columns: int | None = None,
     ) -> FloatArray:
         """The rows of ``keys``, shape (len(keys), heights): ln(density [kg/m^3]).
 
         Rows not held yet are computed in one NRLMSIS call with those of ``ahead()`` (the
         days the caller will want next); the rows of ``after()`` (the days after those) are
         then computed by a forked process (`orbit_env.workers.Forked`, where it may fork)
-        while the caller goes on, and taken in at the next row not held.
+        while the caller goes on, and taken in at the next row not held. With ``columns``,
+        only the first ``columns`` heights need be there (a decay below a height reads no
+        air above it; NRLMSIS's cost is per height): a row is computed, or deepened, to
+        them, and the columns beyond may be NaN.
         """
+        columns = self.heights_m.size if columns is None else min(int(columns), self.heights_m.size)
         rows = [self._row_of.get(key) for key in keys]
-        if None in rows:
-            missing = [key for key, row in zip(keys, rows, strict=True) if row is None]
+        if None in rows or (self._columns.size and np.any(self._columns[rows] < columns)):
+            missing = [key for key, row in zip(keys, rows, strict=True) if row is None or self._columns[row] < columns]
             if self._pending_has(missing):
                 self._collect()
-                missing = [key for key in missing if key not in self._row_of]
+                missing = [key for key in missing if not self._holds(key, columns)]
             if missing:
-                self._add([*missing, *(ahead() if ahead is not None else ())])
+                self._add([*missing, *(ahead() if ahead is not None else ())], columns)
             if after is not None:
-                self._start_background(after())
+                self._start_background(after(), columns)
             rows = [self._row_of[key] for key in keys]
         return self._log_rho[rows]
 
-    def _add(self, keys: Sequence[DayKey]) -> None:
-        new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
-        if new:
-            self._append(*self._computed(new))
+    def _holds(self, key: DayKey, columns: int) -> bool:
+        """Whether the row of ``key`` is held with its first ``columns`` heights."""
+        row = self._row_of.get(key)
+        return row is not None and self._columns[row] >= columns
 
-    def _computed(self, new: list[DayKey]) -> tuple[list[DayKey], FloatArray]:
-        """The keys ``new`` (daily-Ap days first, then storm days) and their rows, by NRLMSIS."""
+    def _add(self, keys: Sequence[DayKey], columns: int) -> None:
+        new = list(dict.fromkeys(key for key in keys if not self._holds(key, columns)))
+        if new:
+            self.merge(*self._computed(new, columns))
+
+    def _computed(self, new: list[DayKey], columns: int) -> tuple[list[DayKey], FloatArray]:
+        """The keys ``new`` (daily-Ap days first, then storm days) and their rows to ``columns`` heights, by NRLMSIS.
+
+        The rows are NaN beyond ``columns``.
+        """
         # Daily-Ap days in one NRLMSIS call, storm days (longer keys) in another.
         new = sorted(new, key=len)
         daily = sum(len(key) == DAILY_KEY for key in new)
-        rho = np.empty((len(new), self.heights_m.size))
+        rho = np.full((len(new), self.heights_m.size), np.nan)
         for part, storm in ((slice(0, daily), False), (slice(daily, None), True)):
             if not new[part]:
                 continue
             values = np.array(new[part], dtype=np.float64)
             f107, f107a, ap, doy = values[:, :DAILY_KEY].T
-            rho[part] = orbit_mean_density_by_day_kg_m3(
-                self.heights_m,
+            rho[part, :columns] = orbit_mean_density_by_day_kg_m3(
+                self.heights_m[:columns],
                 f107,
                 f107a,
                 ap,
@@ -175,9 +192,9 @@ class DailyAirTable:
             )
         return new, np.log(rho)
 
-    def _start_background(self, keys: Sequence[DayKey]) -> None:
+    def _start_background(self, keys: Sequence[DayKey], columns: int) -> None:
         """Have a forked process compute the rows of ``keys`` not held (if this process may fork), a part at a time."""
-        new = list(dict.fromkeys(key for key in keys if key not in self._row_of))
+        new = list(dict.fromkeys(key for key in keys if not self._holds(key, columns)))
         if not new or self._pending is not None or not can_fork():
             return
         new.sort(key=len)  # `_computed`'s order, so that each part keeps it
@@ -185,7 +202,7 @@ class DailyAirTable:
         def fill(out: FloatArray, mark: Callable[[int], None]) -> None:
             for start in range(0, len(new), BACKGROUND_PART):
                 stop = min(start + BACKGROUND_PART, len(new))
-                out[start:stop] = self._computed(new[start:stop])[1]
+                out[start:stop] = self._computed(new[start:stop], columns)[1]
                 mark(stop)
 
         try:
@@ -207,7 +224,7 @@ class DailyAirTable:
                 self.merge(keys[:done], log_rho[:done])
 
     def _append(self, new: list[DayKey], log_rho: FloatArray) -> None:
-        """Hold the rows ``log_rho`` of the keys ``new`` (none held yet); written when the table has grown enough."""
+        """Hold the rows ``log_rho`` of the keys ``new`` (none held yet)."""
         start = len(self._row_of)
         width = max(self._keys.shape[1], max(map(len, new)))
         added = np.full((len(new), width), np.nan)
@@ -216,9 +233,8 @@ class DailyAirTable:
         held = np.pad(self._keys, ((0, 0), (0, width - self._keys.shape[1])), constant_values=np.nan)
         self._keys = np.concatenate([held, added])
         self._log_rho = np.concatenate([self._log_rho, log_rho])
+        self._columns = np.concatenate([self._columns, _computed_columns(log_rho)])
         self._row_of.update({key: start + k for k, key in enumerate(new)})
-        if len(self) >= STORE_GROWTH * self._stored_rows:
-            self.store()
 
     def close(self) -> None:
         """Keep the rows a forked process has finished (it is stopped if still running), and write the table."""
@@ -236,18 +252,45 @@ class DailyAirTable:
         return list(self._row_of)[self._read_rows :], self._log_rho[self._read_rows :]
 
     def merge(self, keys: Sequence[DayKey], log_rho: FloatArray) -> None:
-        """Hold rows another process computed (`new_rows` of a worker's table), but for keys held already."""
-        fresh = [k for k, key in enumerate(keys) if key not in self._row_of]
+        """Hold rows computed here or by another process (`new_rows` of a worker's table).
+
+        A key not held is added; one held with fewer columns than its new row is deepened (the
+        columns it had are NRLMSIS's same values); the table is written when it has changed by
+        a quarter.
+        """
+        log_rho = np.asarray(log_rho)
+        columns = _computed_columns(log_rho)
+        fresh, deeper = [], []
+        for k, key in enumerate(map(tuple, keys)):
+            row = self._row_of.get(key)
+            if row is None:
+                fresh.append(k)
+            elif self._columns[row] < columns[k]:
+                deeper.append(k)
         if fresh:
-            self._append([tuple(keys[k]) for k in fresh], np.asarray(log_rho)[fresh])
+            self._append([tuple(keys[k]) for k in fresh], log_rho[fresh])
+        for k in deeper:
+            row = self._row_of[tuple(keys[k])]
+            self._log_rho[row] = log_rho[k]
+            self._columns[row] = columns[k]
+        self._changes += len(fresh) + len(deeper)
+        if self._changes and self._stored_rows + self._changes >= STORE_GROWTH * self._stored_rows:
+            self.store()
 
     def store(self) -> None:
         """Write the table to the disk cache if it holds rows not written yet."""
-        if len(self) > self._stored_rows:
+        if self._changes:
             # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
             arrays = {"keys": self._keys, "log_density": self._log_rho}
             cache.store("airdays", self._description, arrays, compress=False)
             self._stored_rows = len(self)
+            self._changes = 0
+
+
+def _computed_columns(log_rho: FloatArray) -> NDArray[np.intp]:
+    """Per row, how many leading columns hold a value (NRLMSIS's are never NaN; a column not computed is)."""
+    finite = np.isfinite(log_rho)
+    return np.where(finite.all(axis=1), log_rho.shape[1], np.argmin(finite, axis=1))
 
 
 def _unpadded(stored: list[float]) -> DayKey:

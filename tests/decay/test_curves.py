@@ -155,3 +155,26 @@ def test_lookups_before_the_cells_are_built_equal_those_after_bit_for_bit():
     np.testing.assert_array_equal(np.array(lazy.values(x, y)), np.array(built.values(x, y)))
     scalar = [lazy.values_scalar(float(u), float(v)) for u, v in zip(x[0], y[0], strict=True)]
     np.testing.assert_array_equal(np.array(scalar).T, np.array(lazy.values(x[0], y[0])))
+
+
+@pytest.mark.usefixtures("forking")
+def test_curves_integrated_in_two_processes_are_the_curves_integrated_together(monkeypatch):
+    """Half the curves in a forked child (`orbit_env.workers.in_two_processes`): the same numbers, bit for bit."""
+    from orbit_env import workers
+    from orbit_env.decay import curves as curves_module
+
+    forks = []
+
+    class Counted(workers.Forked):
+        def __init__(self, *args, **kwargs):
+            forks.append(args[1])
+            super().__init__(*args, **kwargs)
+
+    curves = universal_curves()
+    monkeypatch.setattr(workers, "Forked", Counted)
+    tau = np.arange(0.0, curves_module._TAU_TOP + curves_module._DTAU, curves_module._DTAU)
+    split = curves._integrate(tau, curves.labels)
+    assert forks == [(curves.labels.size - curves.labels.size // 2, 3, tau.size)]
+    together = curves._integrate_curves(tau, curves.labels)
+    for a, b in zip(split, together, strict=True):
+        np.testing.assert_array_equal(a, b)

@@ -117,6 +117,28 @@ def test_the_table_is_rewritten_when_it_has_grown_by_a_quarter_and_at_the_end(tm
     assert len(table(tmp_path, monkeypatch)) == 27
 
 
+def test_rows_computed_to_fewer_heights_are_those_heights_of_the_full_rows_and_deepen_on_demand(tmp_path, monkeypatch):
+    """``columns``: a decay below a height computes the first heights only; asked for more, a row is deepened."""
+    full = table(tmp_path / "full", monkeypatch).log_density([*KEYS, STORM_KEY])
+    air = table(tmp_path / "part", monkeypatch)
+    first = air.log_density([*KEYS[:2], STORM_KEY], columns=2)
+    np.testing.assert_array_equal(first[:, :2], full[[0, 1, 3], :2])  # NRLMSIS is pointwise: the same values
+    assert np.all(np.isnan(first[:, 2:]))
+    daily_air._store_all()
+    again = table(tmp_path / "part", monkeypatch)  # a new process: the shallow rows from the disk cache
+    calls = []
+    original = daily_air.orbit_mean_density_by_day_kg_m3
+    monkeypatch.setattr(
+        daily_air, "orbit_mean_density_by_day_kg_m3", lambda *a, **k: calls.append(a[0].size) or original(*a, **k)
+    )
+    np.testing.assert_array_equal(again.log_density(KEYS[:2], columns=1), first[:2])  # held: no NRLMSIS
+    assert calls == []
+    deeper = again.log_density([*KEYS, STORM_KEY])  # all heights: the three rows deepened, one row new
+    np.testing.assert_array_equal(deeper, full)
+    assert sorted(calls) == [3, 3]  # one call for the daily-Ap days, one for the storm day, at every height
+    assert len(again) == 4
+
+
 #: A storm day's key: its indices, then the 27 3-hourly ap from 57 h before its first slot to its last: those
 #: of 2003-10-26 (from its sixth slot) to 2003-10-29 in CelesTrak's SW-All.txt (tests/decay/test_solar_record.py).
 STORM_KEY = (

@@ -184,3 +184,27 @@ def test_rule_under_a_solar_cycle(msis):
     assert not check.complies[0] and check.dv_m_s[0] > 0
     after = scenario.lifetime_days(check.new_perigee_m, 550e3, SATELLITE.drag_parameter_m2_kg, 51.6)[0][0]
     assert after <= 5 * 365.25
+
+
+def test_a_decay_reads_no_air_above_its_orbits_own_heights(msis, monkeypatch, tmp_path):
+    """The days' air computed up to the orbits' apogees only (`SolarDecayModel.air_columns`) gives the lifetimes
+    of the air at every height, bit for bit: the decay never reads the heights it leaves out (they are NaN)."""
+    from orbit_env.decay import chunked
+    from orbit_env.decay.chunked import SolarDecayModel, propagate
+    from orbit_env.decay.solar_record import load_record
+
+    # The October 2003 storms (storm-time rows), a near-circular and a wide orbit (the averaged ratio), two planes.
+    hp, ha = np.array([200e3, 190e3, 230e3]), np.array([260e3, 900e3, 240e3])
+    days = {}
+    for above in (chunked.AIR_COLUMNS_ABOVE, 100):  # 100: beyond the grid, every height
+        monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path / str(above)))
+        monkeypatch.setattr(chunked, "AIR_COLUMNS_ABOVE", above)
+        for cached in (chunked.daily_air_table, chunked._log_ratio, chunked._log_ratios_by_day):
+            cached.cache_clear()
+        model = SolarDecayModel(load_record(), unix_days("2003-10-20"), 51.6, rotating_atmosphere=True)
+        assert model.air_columns() is None  # no orbit yet: every height
+        days[above] = propagate(hp, ha, SATELLITE.drag_parameter_m2_kg, model).days
+        held = chunked.air_table(51.6, None, model.version)._log_rho
+        assert np.isnan(held).any() == (above < 100)  # the heights above 900 km + 2 steps were left out
+    np.testing.assert_array_equal(days[chunked.AIR_COLUMNS_ABOVE], days[100])
+    assert np.all(days[100] < 60.0)  # lives of days to weeks: a quick test
