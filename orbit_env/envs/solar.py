@@ -178,18 +178,18 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         state = self._state
         if state is None:
             raise RuntimeError("call reset() before step()")
-        result, obs = solar_task.step_and_observe(self.task, state, self.task.requested_dv(action))
-        burn = float(result.burn_m_s[0])
+        obs, reward, terminated, truncated, burn, disposal, complies = solar_task.step_and_observe_one(
+            self.task, state, self.task.requested_dv(action)
+        )
         self._dv_used_m_s += burn
         info: dict[str, Any] = {"burn_m_s": burn, **self._outcome()}
-        truncated = bool(result.truncated[0])
         if truncated:
-            info["disposal_dv_m_s"] = float(result.disposal_m_s[0])
-            info["complies"] = bool(result.complies[0])
-            self._dv_used_m_s += info["disposal_dv_m_s"]
+            info["disposal_dv_m_s"] = disposal
+            info["complies"] = complies
+            self._dv_used_m_s += disposal
             info["dv_used_m_s"] = self._dv_used_m_s
         self._last = info
-        return obs[0], float(result.reward[0]), bool(result.terminated[0]), truncated, info
+        return obs, reward, terminated, truncated, info
 
     def _outcome(self) -> dict[str, Any]:
         data = self._state.data  # a batch of one: column 0 (read directly, as the step is timed against CartPole's)

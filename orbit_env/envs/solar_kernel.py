@@ -118,6 +118,23 @@ def _coast(
     whose W runs out re-enters at that fraction of the span (the span's mean rate).
     """
     _, _, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
+    return _coast_from(label, nu, q, perigee_m, apogee_m, gc, first_day, days, b_cells, b_grid, cumulative)
+
+
+def _coast_from(
+    label: float,
+    nu: float,
+    q: float,
+    perigee_m: float,
+    apogee_m: float,
+    gc: float,
+    first_day: float,
+    days: float,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+) -> tuple[float, float, float, float, float, float, float]:
+    """`_coast` of an orbit whose mean period left ``q`` (W / nu) is known: the period a coast before it returned."""
     weighted = q * nu
     whole = math.ceil(days)
     drag = drag_days_at(cumulative, perigee_m, first_day, first_day + whole) * (days / whole)
@@ -156,15 +173,16 @@ def _life_margin(
         return -horizon_days
     t = 0.0
     rate = 0.0
+    _, _, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
     while t < horizon_days:
         span = min(block_days, horizon_days - t)
-        lived, nu, _, perigee_m, apogee_m, _, rate = _coast(
-            label, nu, perigee_m, apogee_m, gc, first_day + t, span, b_cells, b_grid, cumulative
+        # Each coast's closing lookup (its nu's period) is the next one's opening lookup: taken along.
+        lived, nu, _, perigee_m, apogee_m, q, rate = _coast_from(
+            label, nu, q, perigee_m, apogee_m, gc, first_day + t, span, b_cells, b_grid, cumulative
         )
         if nu <= 0.0:
             return t + lived - horizon_days
         t += span
-    _, _, q = _curve_at(label, math.log1p(nu / NU_REF), b_cells, b_grid)
     return q * nu / (gc * max(rate, MIN_RATE) * SECONDS_PER_DAY)
 
 
@@ -494,6 +512,34 @@ def _step_observe_rows(
     return ending
 
 
+def _step_observe_one(
+    data: FloatArray,
+    requested_m_s: float,
+    p: FloatArray,
+    block_days: float,
+    index_scale: float,
+    a_cells: FloatArray,
+    a_grid: FloatArray,
+    b_cells: FloatArray,
+    b_grid: FloatArray,
+    cumulative: FloatArray,
+    indices: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+) -> tuple[NDArray[np.float32], float, float, bool, bool]:
+    """`_step_observe_rows` of a batch of one (the single environment: no arrays to allocate around the call).
+
+    Returns:
+        (the observation (components,), the burn made [m/s], the reward [days], terminated, truncated).
+    """
+    obs = np.empty((1, low.size), dtype=np.float32)
+    dv, reward, terminated, truncated = _step_row(
+        data, 0, requested_m_s, p, block_days, a_cells, a_grid, b_cells, b_grid, cumulative
+    )
+    _observe_row(data, 0, p, block_days, index_scale, indices, low, high, obs)
+    return obs[0], dv, reward, terminated, truncated
+
+
 class _Loops(NamedTuple):
     """The loops over orbits (compiled, or the plain functions with ``ORBIT_ENV_JIT=0``)."""
 
@@ -503,9 +549,12 @@ class _Loops(NamedTuple):
     step_rows: Any
     observe_rows: Any
     step_observe_rows: Any
+    step_observe_one: Any
 
 
-_PLAIN = _Loops(_coast_rows, _life_margin_rows, _disposal_rows, _step_rows, _observe_rows, _step_observe_rows)
+_PLAIN = _Loops(
+    _coast_rows, _life_margin_rows, _disposal_rows, _step_rows, _observe_rows, _step_observe_rows, _step_observe_one
+)
 
 
 @lru_cache(maxsize=1)
@@ -516,7 +565,7 @@ def loops() -> _Loops:
     import numba
 
     kernel_loops()  # registers the known-density loops' helpers (burn_row and what it calls)
-    helpers = (drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast, _step_row, _observe_row)
+    helpers = (drag_days_at, _curve_at, _kepler_period_s, _nu_at_weight, _coast_from, _coast, _step_row, _observe_row)
     for helper in (*helpers, _life_margin, _candidate_margin, _disposal_perigee):
         numba.extending.register_jitable(helper)
     return _Loops(*(numba.njit(cache=True, nogil=True)(loop) for loop in _PLAIN))
@@ -679,3 +728,30 @@ def observe_rows(
     obs = np.empty((data.shape[1], bounds.shape[1]), dtype=np.float32)
     loops().observe_rows(data, parameters, float(block_days), float(index_scale), t.indices, bounds[0], bounds[1], obs)
     return obs
+
+
+def step_observe_one(
+    t: SolarTables,
+    data: FloatArray,
+    requested_m_s: float,
+    parameters: FloatArray,
+    block_days: float,
+    index_scale: float,
+    bounds: FloatArray,
+) -> tuple[NDArray[np.float32], float, float, bool, bool]:
+    """`_step_observe_one` of a batch of one: (observation, burn made, reward, terminated, truncated)."""
+    return loops().step_observe_one(
+        data,
+        requested_m_s,
+        parameters,
+        block_days,
+        index_scale,
+        t.a_cells,
+        t.a_grid,
+        t.b_cells,
+        t.b_grid,
+        t.cumulative,
+        t.indices,
+        bounds[0],
+        bounds[1],
+    )

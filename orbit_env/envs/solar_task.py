@@ -276,7 +276,8 @@ def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping
             )
     perigee_km = np.broadcast_to(np.asarray(options.get("perigee_km", perigee_km), dtype=np.float64), (size,))
     apogee_km = np.broadcast_to(np.asarray(options.get("apogee_km", apogee_km), dtype=np.float64), (size,))
-    task.curves.check_domain_km(perigee_km, apogee_km)
+    if "perigee_km" in options or "apogee_km" in options:  # drawn ones are in the domain: the config is checked
+        task.curves.check_domain_km(perigee_km, apogee_km)
     state = BatchState(size)
     state.dry_mass_kg = config.dry_mass_kg
     state.mass_kg = config.wet_mass_kg
@@ -432,6 +433,39 @@ def step_and_observe(
         rows = np.flatnonzero(result.truncated)
         obs[rows] = observe(task, state.take(rows))
     return result, obs
+
+
+def step_and_observe_one(
+    task: SolarTask, state: BatchState, requested_dv_m_s: float
+) -> tuple[NDArray[np.float32], float, bool, bool, float, float, bool]:
+    """`step_and_observe` of a batch of one, as the single environment reads it: numbers, not arrays.
+
+    Returns:
+        (the observation (11,), the reward, terminated, truncated, the burn made, the disposal
+        burn made and whether the orbit complies: the last two as `SolarStep`'s off the mission's end).
+    """
+    obs, dv, reward, terminated, truncated = solar_kernel.step_observe_one(
+        task.tables,
+        state.data,
+        float(requested_dv_m_s),
+        task.kernel_parameters,
+        float(task.mission.block_days),
+        SOLAR_INDEX_SCALE,
+        _BOUNDS,
+    )
+    if not truncated:
+        return obs, reward, terminated, False, dv, 0.0, True
+    moved = (np.array([dv]), np.array([reward]), np.array([terminated]), np.array([truncated]))
+    result = _rule_at_the_end(task, state, *moved, 1)
+    return (
+        observe(task, state)[0],  # the disposal burn spent propellant: observed again
+        float(result.reward[0]),
+        terminated,
+        True,
+        dv,
+        float(result.disposal_m_s[0]),
+        bool(result.complies[0]),
+    )
 
 
 def _rule_at_the_end(

@@ -259,6 +259,32 @@ def test_a_start_replays_exactly() -> None:
     assert fly_env(options=dict(options)) == pytest.approx(first, abs=1e-9)
 
 
+def test_the_single_env_steps_as_the_task_model() -> None:
+    # The single environment's own compiled call (step_and_observe_one) against the task model's batch
+    # functions (step, then observe) on the same missions, through the rule's judgement: bit for bit.
+    env = gym.make(SOLAR_ENV_ID, solar_split="test")
+    task = env.unwrapped.task
+    rng = np.random.default_rng(5)
+    judged = 0
+    for seed in range(3):
+        _, info = env.reset(seed=seed)
+        state = st.start(task, rng, 1, env.unwrapped.start_options)
+        actions = rng.integers(0, 4, task.config.horizon_steps)
+        for action in actions:
+            obs, reward, terminated, truncated, info = env.step(int(action))
+            result = st.step(task, state, np.array([task.requested_dv(int(action))]))
+            np.testing.assert_array_equal(obs, st.observe(task, state)[0])
+            assert (reward, terminated, truncated) == (result.reward[0], result.terminated[0], result.truncated[0])
+            assert info["burn_m_s"] == result.burn_m_s[0]
+            if terminated or truncated:
+                break
+        np.testing.assert_array_equal(env.unwrapped.task_state.data, state.data)
+        if truncated:
+            assert (info["disposal_dv_m_s"], info["complies"]) == (result.disposal_m_s[0], result.complies[0])
+            judged += 1
+    assert judged  # the mission's end, its rule and the observation after the disposal burn, compared too
+
+
 def test_the_vector_env_restarts_on_the_next_step() -> None:
     env = gym.make_vec(SOLAR_ENV_ID, num_envs=6, horizon_steps=3)
     obs, info = env.reset(seed=0)
