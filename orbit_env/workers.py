@@ -1,6 +1,6 @@
-"""Worker processes: a pool of spawned processes, and forked children for work beside this process.
+"""Worker processes: pools of spawned (or forked) processes, and forked children for work beside this process.
 
-`spawned_pool` stops its workers at once on Ctrl-C or a failure. `Forked` has a forked child
+`spawned_pool` and `worker_pool` stop their workers at once on Ctrl-C or a failure. `Forked` has a forked child
 fill an array in shared memory while this process goes on; `in_two_processes` splits a large
 pointwise computation (NRLMSIS at many points) over this process and a forked child.
 """
@@ -17,7 +17,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -31,8 +31,7 @@ from orbit_env.cache import OFF_SETTINGS
 FORK_MIN_POINTS = 50_000
 
 
-@contextmanager
-def spawned_pool(processes: int, **kwargs: Any) -> Iterator[ProcessPoolExecutor]:
+def spawned_pool(processes: int, **kwargs: Any) -> AbstractContextManager[ProcessPoolExecutor]:
     """A `ProcessPoolExecutor` of ``processes`` spawned processes (``kwargs``: its other arguments).
 
     Spawned, not forked: a worker starts from a clean interpreter (no copy of the parent's
@@ -40,7 +39,25 @@ def spawned_pool(processes: int, **kwargs: Any) -> Iterator[ProcessPoolExecutor]
     are terminated and the queued tasks cancelled, rather than waited for; else the pool is
     shut down when its tasks are done.
     """
-    executor = ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context("spawn"), **kwargs)
+    return _stopped_on_error(ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context("spawn"), **kwargs))
+
+
+def worker_pool(processes: int) -> AbstractContextManager[ProcessPoolExecutor]:
+    """`spawned_pool`, but forked where `can_fork` says so: workers with this process's modules and tables.
+
+    For a few tasks of a second or so (the uncertainty's solar nodes), where a spawned worker's
+    start (the interpreter, the imports, the curves and the air read again) is a good part of
+    the wall time. The pool forks its workers at its first task, before its management thread
+    starts; a forked worker forks no further, and ends without this process's exit handlers
+    (nothing written to the disk cache twice).
+    """
+    method = "fork" if can_fork() else "spawn"
+    return _stopped_on_error(ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context(method)))
+
+
+@contextmanager
+def _stopped_on_error(executor: ProcessPoolExecutor) -> Iterator[ProcessPoolExecutor]:
+    """``executor`` for a block: its workers terminated at once on an exception, else shut down at its end."""
     try:
         yield executor
     except BaseException:

@@ -240,19 +240,19 @@ def propagate_nodes(
     """Each node's samples propagated (`orbit_env.decay.chunked.propagate`): their days and whether they re-entered.
 
     ``orbit`` is (perigee [m], apogee [m], drag parameter [m^2/kg]), ``density_scale`` every
-    sample's factor. With ``workers`` > 1 the nodes after the first run in as many spawned
-    processes while this one runs the first (the nominal forecast's, whose air is in memory);
-    the workers' new rows of the real Sun's air come back with their results
-    (`orbit_env.decay.daily_air.merge_rows`). Each node runs on its own arithmetic, so the
-    results are the same bit for bit in any process.
+    sample's factor. With ``workers`` > 1 the nodes after the first run in as many worker
+    processes (`orbit_env.workers.worker_pool`: forked where it may) while this one runs the
+    first (the nominal forecast's, whose air is in memory); the workers' new rows of the real
+    Sun's air come back with their results (`orbit_env.decay.daily_air.merge_rows`). Each node
+    runs on its own arithmetic, so the results are the same bit for bit in any process.
     """
     from orbit_env.decay import daily_air
 
     if workers <= 1 or len(runs) <= 1:
         return [_propagate_node(orbit, model, density_scale[needed])[:2] for _, needed, model in runs]
-    from orbit_env.workers import spawned_pool
+    from orbit_env.workers import worker_pool
 
-    with spawned_pool(min(workers, len(runs) - 1)) as pool:  # Ctrl-C or a failed node stops the workers now
+    with worker_pool(min(workers, len(runs) - 1)) as pool:  # Ctrl-C or a failed node stops the workers now
         futures = [
             pool.submit(_propagate_node, orbit, model, density_scale[needed], True) for _, needed, model in runs[1:]
         ]

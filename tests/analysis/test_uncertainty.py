@@ -127,17 +127,30 @@ def test_each_node_propagates_only_its_samples_with_the_same_lifetimes():
     np.testing.assert_array_equal(spread.days, expected)
 
 
-def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_air(tmp_path, monkeypatch):
-    # --workers runs the solar nodes after the first in spawned processes: the same lifetimes bit for bit,
-    # and the rows of the real Sun's air they computed come back to this process's tables (else the next run
-    # would compute them again: two processes writing one table on disk keep one's rows).
+@pytest.mark.parametrize("forked", [True, False])
+def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_air(
+    tmp_path, monkeypatch, request, forked
+):
+    # --workers runs the solar nodes after the first in worker processes (forked where this process may fork,
+    # else spawned): the same lifetimes bit for bit, and the rows of the real Sun's air they computed come back
+    # to this process's tables (else the next run would compute them again: two processes writing one table on
+    # disk keep one's rows).
     pytest.importorskip("pymsis")
+    from orbit_env import workers
     from orbit_env.decay import daily_air
     from orbit_env.decay.solar_record import load_record
 
+    if forked:
+        request.getfixturevalue("forking")
+    else:
+        monkeypatch.setattr(workers, "can_fork", lambda: False)
+    methods = []
+    context = workers.multiprocessing.get_context
+    monkeypatch.setattr(workers.multiprocessing, "get_context", lambda how: methods.append(how) or context(how))
     monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))  # the workers find no air on disk
     record = load_record()
-    start = record.observed_end_days + 45.0  # scaled forecasts no other test of this process has met
+    # Scaled forecasts no other test of this process has met.
+    start = record.observed_end_days + (45.0 if forked else 75.0)
     scenario = Scenario(MsisAir(record, start), rotating_atmosphere=True)
     hp, c, n = 300e3, 0.0165, 60
     parallel = U.lifetime_spread(hp, hp, c, scenario, 51.6, samples=n, seed=13, workers=2)
@@ -147,6 +160,7 @@ def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_a
 
     monkeypatch.setattr(daily_air, "orbit_mean_density_by_day_kg_m3", no_nrlmsis)
     serial = U.lifetime_spread(hp, hp, c, scenario, 51.6, samples=n, seed=13, workers=1)
+    assert methods == ["fork" if forked else "spawn"]
     np.testing.assert_array_equal(parallel.days, serial.days)
     np.testing.assert_array_equal(parallel.reentered, serial.reentered)
     assert np.all(serial.reentered)
