@@ -1,9 +1,11 @@
-"""`orbit_env.workers.in_two_processes`: a pointwise computation split with a forked child."""
+"""`orbit_env.workers`: work split with a forked child (`in_two_processes`), and the worker pools."""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -137,3 +139,16 @@ def test_one_cpu_of_quota_or_the_switch_keeps_the_work_here(monkeypatch: pytest.
     monkeypatch.setenv(workers.FORK_ENV_VAR, "off")
     assert not workers.can_fork()
     assert np.all(workers.in_two_processes(pids, POINTS) == os.getpid())
+
+
+@pytest.mark.usefixtures("forking")
+def test_a_failure_in_a_pools_block_stops_its_workers_at_once() -> None:
+    """Ctrl-C (here an error) while a worker runs a long task: the workers are terminated, not waited for."""
+    start = time.monotonic()
+    with pytest.raises(RuntimeError, match="stop"), workers.worker_pool(1) as pool:
+        future = pool.submit(time.sleep, 60.0)
+        time.sleep(0.2)  # the worker has started the long task
+        raise RuntimeError("stop")
+    assert time.monotonic() - start < 20.0
+    assert not future.done() or future.cancelled() or future.exception() is not None
+    assert not multiprocessing.active_children()
