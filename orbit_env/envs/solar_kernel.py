@@ -1,11 +1,12 @@
 """The solar task's step, month of decay, rule and disposal burn, compiled: loops over the orbits (numba).
 
-The one implementation of `orbit_env.envs.solar_task`'s step (`step_rows`: the perigee burn,
-`orbit_env.envs.kernel.burn_row`, then the month's coast) and observation (`observe_rows`),
+The one implementation of `orbit_env.envs.solar_task`'s step (`_step_row`: the perigee burn,
+`orbit_env.envs.kernel.burn_row`, then the month's coast) and observation (`_observe_row`),
 of its coast (`coast_block`), of the rule's judgement (`life_margin_days`) and of the
 cheapest compliant disposal burn (`disposal`): plain-float functions of one orbit, compiled
-by numba into loops over arrays
-(with ``ORBIT_ENV_JIT=0`` the same functions run uncompiled, slowly). An orbit's month is
+by numba into loops over arrays (`step_rows`, `observe_rows`, both in one loop for the
+environments, `step_observe_rows`, and for the single environment's one orbit
+`step_observe_one`; with ``ORBIT_ENV_JIT=0`` the same functions run uncompiled, slowly). An orbit's month is
 a handful of table lookups; the rule at a mission's end decays it (and each candidate
 disposal) month by month over five years, which numpy spent in thousands of small calls.
 
