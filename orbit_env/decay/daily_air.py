@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import atexit
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -140,26 +140,24 @@ class DailyAirTable:
         them, and the columns beyond may be NaN.
         """
         columns = self.heights_m.size if columns is None else min(int(columns), self.heights_m.size)
-        rows = [self._row_of.get(key) for key in keys]
-        if None in rows or (self._columns.size and np.any(self._columns[rows] < columns)):
-            missing = [key for key, row in zip(keys, rows, strict=True) if row is None or self._columns[row] < columns]
+        missing = self._not_held(keys, columns)
+        if missing:
             if self._pending_has(missing):
                 self._collect()
-                missing = [key for key in missing if not self._holds(key, columns)]
+                missing = self._not_held(missing, columns)
             if missing:
                 self._add([*missing, *(ahead() if ahead is not None else ())], columns)
             if after is not None:
                 self._start_background(after(), columns)
-            rows = [self._row_of[key] for key in keys]
-        return self._log_rho[rows]
+        return self._log_rho[[self._row_of[key] for key in keys]]
 
-    def _holds(self, key: DayKey, columns: int) -> bool:
-        """Whether the row of ``key`` is held with its first ``columns`` heights."""
-        row = self._row_of.get(key)
-        return row is not None and self._columns[row] >= columns
+    def _not_held(self, keys: Iterable[DayKey], columns: int) -> list[DayKey]:
+        """The keys (each once, in order) whose rows are not held with their first ``columns`` heights."""
+        row_of, held = self._row_of, self._columns
+        return list(dict.fromkeys(key for key in keys if (row := row_of.get(key)) is None or held[row] < columns))
 
     def _add(self, keys: Sequence[DayKey], columns: int) -> None:
-        new = list(dict.fromkeys(key for key in keys if not self._holds(key, columns)))
+        new = self._not_held(keys, columns)
         if new:
             self.merge(*self._computed(new, columns))
 
@@ -194,7 +192,7 @@ class DailyAirTable:
 
     def _start_background(self, keys: Sequence[DayKey], columns: int) -> None:
         """Have a forked process compute the rows of ``keys`` not held (if this process may fork), a part at a time."""
-        new = list(dict.fromkeys(key for key in keys if not self._holds(key, columns)))
+        new = self._not_held(keys, columns)
         if not new or self._pending is not None or not can_fork():
             return
         new.sort(key=len)  # `_computed`'s order, so that each part keeps it

@@ -645,6 +645,17 @@ def disposal_perigee_rows(
     return out
 
 
+def _step_arrays(
+    n: int, requested_m_s: Any
+) -> tuple[FloatArray, FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_]]:
+    """A step's burns asked for as an array of ``n``, and its outputs' arrays: made, reward, terminated, truncated."""
+    requested = np.asarray(requested_m_s, dtype=np.float64)
+    if requested.shape != (n,):
+        requested = np.full(n, float(requested))
+    made, reward = np.empty(n), np.empty(n)
+    return requested, made, reward, np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
+
+
 def step_rows(
     t: SolarTables,
     data: FloatArray,
@@ -653,12 +664,7 @@ def step_rows(
     block_days: float,
 ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_], int]:
     """`_step_rows` of a batch's state array: (burns made, reward, terminated, truncated, how many truncated)."""
-    n = data.shape[1]
-    made, reward = np.empty(n), np.empty(n)
-    terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
-    requested = np.asarray(requested_m_s, dtype=np.float64)
-    if requested.shape != (n,):
-        requested = np.full(n, float(requested))
+    requested, made, reward, terminated, truncated = _step_arrays(data.shape[1], requested_m_s)
     ending = loops().step_rows(
         data,
         requested,
@@ -687,13 +693,8 @@ def step_observe_rows(
     bounds: FloatArray,
 ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_], NDArray[np.bool_], int, NDArray[np.float32]]:
     """`_step_observe_rows` of a batch's state array: `step_rows`'s five, then the observations (n, components)."""
-    n = data.shape[1]
-    made, reward = np.empty(n), np.empty(n)
-    terminated, truncated = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_)
-    obs = np.empty((n, bounds.shape[1]), dtype=np.float32)
-    requested = np.asarray(requested_m_s, dtype=np.float64)
-    if requested.shape != (n,):
-        requested = np.full(n, float(requested))
+    requested, made, reward, terminated, truncated = _step_arrays(data.shape[1], requested_m_s)
+    obs = np.empty((data.shape[1], bounds.shape[1]), dtype=np.float32)
     ending = loops().step_observe_rows(
         data,
         requested,
