@@ -47,9 +47,14 @@ def forking(monkeypatch):
     Skipped off Linux or on one core. The idle Python threads that earlier tests leave behind
     (tensorboard's writers of the training tests) would forbid the fork; they never touch
     what a child computes, so they are let be here (the guard itself is tested in test_workers.py).
+    A child that an earlier decay left computing the real Sun's air would forbid it too: the
+    tables take in what their children finished (as at the process's end).
     """
     from orbit_env import workers
+    from orbit_env.decay import daily_air
 
     monkeypatch.setattr(workers, "_other_threads", lambda: 0)
+    for table in list(daily_air._TABLES):
+        table.close()
     if not workers.can_fork():
         pytest.skip("needs Linux and two cores")
