@@ -20,16 +20,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
+from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 from orbit_env.agents.policies import HAND_CODED
 from orbit_env.envs import ENV_IDS
 
 FloatArray = NDArray[np.float64]
 
-#: Default seed of the evaluation episodes (training uses 0).
-EVAL_SEED = 12345
-#: Default number of episodes: with 1000 the paired difference of two good policies has a
-#: standard error of about 0.1 day (0.3 with 200), below the gaps between them.
-EVAL_EPISODES = 1000
 #: Episodes whose returns differ by less than this [days] count as ties in the paired comparison.
 TIE_DAYS = 0.01
 #: The Stable-Baselines3 algorithms ``orbit-env evaluate --model`` loads.

@@ -10,21 +10,22 @@ from __future__ import annotations
 import atexit
 import math
 import mmap
-import multiprocessing
 import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.cache import OFF_SETTINGS
+
+if TYPE_CHECKING:  # imported where a pool is made: a command that makes none does not import them
+    from concurrent.futures import ProcessPoolExecutor
 
 #: Points below which `in_two_processes` computes in this process alone: a fork costs a few milliseconds
 #: (measured 5-15 ms for a process with numpy and pymsis loaded), NRLMSIS 0.5-1 us a point.
@@ -39,7 +40,7 @@ def spawned_pool(processes: int, **kwargs: Any) -> AbstractContextManager[Proces
     are terminated and the queued tasks cancelled, rather than waited for; else the pool is
     shut down when its tasks are done.
     """
-    return _stopped_on_error(ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context("spawn"), **kwargs))
+    return _stopped_on_error(_pool(processes, "spawn", **kwargs))
 
 
 def worker_pool(processes: int) -> AbstractContextManager[ProcessPoolExecutor]:
@@ -51,8 +52,14 @@ def worker_pool(processes: int) -> AbstractContextManager[ProcessPoolExecutor]:
     starts; a forked worker forks no further, and ends without this process's exit handlers
     (nothing written to the disk cache twice).
     """
-    method = "fork" if can_fork() else "spawn"
-    return _stopped_on_error(ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context(method)))
+    return _stopped_on_error(_pool(processes, "fork" if can_fork() else "spawn"))
+
+
+def _pool(processes: int, method: str, **kwargs: Any) -> ProcessPoolExecutor:
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(processes, mp_context=multiprocessing.get_context(method), **kwargs)
 
 
 @contextmanager
@@ -112,11 +119,18 @@ def can_fork() -> bool:
         and os.environ.get(FORK_ENV_VAR, "").strip().lower() not in OFF_SETTINGS
         and sys.platform.startswith("linux")
         and _cores() >= 2
-        and multiprocessing.parent_process() is None
         and not _other_threads()
         and not any(child.running() for child in list(_children))
-        and not multiprocessing.active_children()
+        and not _in_pool()
     )
+
+
+def _in_pool() -> bool:
+    """Whether this process is a pool's worker or has pool workers running (multiprocessing not imported: neither)."""
+    multiprocessing = sys.modules.get("multiprocessing")
+    if multiprocessing is None:
+        return False
+    return multiprocessing.parent_process() is not None or bool(multiprocessing.active_children())
 
 
 def _other_threads() -> int:

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
 
 from orbit_env.analysis.catalogue_io import ID_COLUMNS, LINE_KEY, format_value
 from orbit_env.analysis.disposal import check_disposal_rule
@@ -238,6 +237,8 @@ def batch_lifetimes(
     families: set[float] = set()
     inputs = (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg)
     outputs = (days, reentered, complies, new_hp, dv)
+    from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
+
     with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
         if one_family:
             members = np.flatnonzero(ok)

@@ -28,15 +28,15 @@ import re
 import signal
 import threading
 from collections.abc import Callable, Iterable
-from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
-
-from tqdm import tqdm
+from typing import TYPE_CHECKING, Any
 
 from orbit_env.analysis.catalogue_io import atomic_text, write_records
 from orbit_env.workers import spawned_pool
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future
 
 #: A chunk's rows at most: on the time-stepped path (a dated air, 1000 samples of a 13-year life take
 #: about 36 s a row), so a stopped run loses minutes, not hours; on a fixed profile (milliseconds a row).
@@ -132,6 +132,8 @@ def run_in_parts(
         + (f"; Ray at {address}" if address else f"; {processes} worker{'s' if processes > 1 else ''}")
     )
     rows_done = sum(bounds[k][1] - bounds[k][0] for k in done)
+    from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
+
     with tqdm(total=n_rows, initial=rows_done, disable=not progress, unit="row", desc="lifetimes") as bar:
 
         def keep(k: int, records: Records) -> None:
@@ -160,6 +162,7 @@ def _run_pool(
     keep: Keep,
 ) -> None:
     """Run ``chunks`` (index, start, stop) on ``processes`` spawned workers; ``keep`` each chunk's records."""
+    from concurrent.futures import FIRST_COMPLETED, wait
 
     def finished(futures: list[Future[Records]]) -> list[tuple[Any, Records]]:
         done, _ = wait(futures, return_when=FIRST_COMPLETED)
@@ -248,6 +251,8 @@ def _start_worker(compute: Compute) -> None:
     tqdm's lock is a thread lock here: its default, a multiprocessing lock, would be a
     semaphore that a worker stopped by the parent leaves behind (and Python warns of it).
     """
+    from tqdm import tqdm
+
     global _compute
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     tqdm.set_lock(threading.RLock())

@@ -234,7 +234,7 @@ def add_parsers(sub: Any) -> None:
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     tr.set_defaults(func=_cmd_train)
 
-    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED
+    from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 
     ev = sub.add_parser("evaluate", help="every policy on the same seeded episodes: when does a burn pay off?")
     ev.add_argument("--env", default="OrbitRaising-v0", metavar="ID", help="environment id (default OrbitRaising-v0)")

@@ -17,8 +17,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-import gymnasium
-
 from orbit_env.envs.config import UNCERTAIN_DENSITY, DensityConfig, OrbitRaisingConfig
 
 if TYPE_CHECKING:
@@ -58,6 +56,8 @@ def register_envs() -> None:
     ``horizon_steps`` (a flat keyword of ``gymnasium.make``), the one owner of the
     truncation and of the observed clock.
     """
+    import gymnasium
+
     entry_points = {env_id: (_ENTRY_POINT, _VECTOR_ENTRY_POINT) for env_id in _VARIANTS}
     entry_points[SOLAR_ENV_ID] = _SOLAR_ENTRY_POINTS
     for env_id, (entry_point, vector_entry_point) in entry_points.items():

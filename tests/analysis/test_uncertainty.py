@@ -145,8 +145,10 @@ def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_a
     else:
         monkeypatch.setattr(workers, "can_fork", lambda: False)
     methods = []
-    context = workers.multiprocessing.get_context
-    monkeypatch.setattr(workers.multiprocessing, "get_context", lambda how: methods.append(how) or context(how))
+    pool = workers._pool
+    monkeypatch.setattr(
+        workers, "_pool", lambda processes, how, **kw: methods.append(how) or pool(processes, how, **kw)
+    )
     monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))  # the workers find no air on disk
     record = load_record()
     # Scaled forecasts no other test of this process has met.
