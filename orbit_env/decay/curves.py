@@ -172,9 +172,9 @@ class BilinearGrid:
     operations in the same order, so they give the same results, bit for bit.
 
     The cells (four times the tables' size) are built the first time something asks for
-    them, or after `CORNER_LOOKUPS` lookups; until then ``values`` takes each point's four
-    corners from the tables and forms the same coefficients by the same operations, so the
-    results are the same bit for bit either way. A decay under the real Sun visits tens of
+    them, or after `CORNER_LOOKUPS` lookups; until then ``values`` (and the scalar lookups)
+    takes each point's four corners from the tables and forms the same coefficients by the
+    same operations, so the results are the same bit for bit either way. A decay under the real Sun visits tens of
     bins' curves for a few lookups each, where building the cells would be most of its
     time; the uncertainty's samples look a bin up thousands of times, where the cells pay.
     """
@@ -321,8 +321,23 @@ class BilinearGrid:
         """
         row, tx, _, ty = grid_cell(x, y, *self.scales)
         txy = tx * ty
-        # The cell's coefficients as Python floats in one call (item() per number costs four times more).
-        return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self.cells[row].tolist()]
+        return [c1 * tx + c0 + c2 * ty + c3 * txy for c0, c1, c2, c3 in self._cell_scalar(row)]
+
+    def _cell_scalar(self, row: int) -> list[list[float]]:
+        """The coefficients of cell ``row``, per table, as Python floats (`cells`' row, or formed from its corners).
+
+        From the corners while the cells are not built (`CORNER_LOOKUPS`), by `_coefficients`' operations in its
+        order: the same floats. A lifetime on one set of curves looks them up a few times, where building the
+        cells took 14 ms of a 0.23 s command.
+        """
+        self._corner_lookups += 1
+        if "cells" in self.__dict__ or self._corner_lookups > CORNER_LOOKUPS:
+            # As Python floats in one call (item() per number costs four times more).
+            return self.cells[row].tolist()
+        i, j = divmod(row, self.ny)
+        f00, f01 = self.corners[i, j : j + 2].tolist()
+        f10, f11 = self.corners[i + 1, j : j + 2].tolist()
+        return [[a, b - a, c - a, d - b - c + a] for a, b, c, d in zip(f00, f10, f01, f11, strict=True)]
 
     def segment_scalar(self, x: float, y: float) -> tuple[list[float], float]:
         """`segments` for one point, in plain floats: the list [j, bases..., slopes...], and ty.
@@ -331,7 +346,7 @@ class BilinearGrid:
         environment's orbit follows the same lines as a vector environment's, bit for bit.
         """
         row, tx, j, ty = grid_cell(x, y, *self.scales)
-        cell = self.cells[row].tolist()
+        cell = self._cell_scalar(row)
         bases = [c1 * tx + c0 for c0, c1, _, _ in cell]
         slopes = [c3 * tx + c2 for _, _, c2, c3 in cell]
         return [float(j), *bases, *slopes], ty

@@ -146,6 +146,10 @@ def test_lookups_before_the_cells_are_built_equal_those_after_bit_for_bit():
         np.testing.assert_array_equal(a, b)
     for a, b in zip(lazy.values(3.3, y), built.values(3.3, y), strict=True):  # a scalar against an array
         np.testing.assert_array_equal(a, b)
+    # One orbit's lookups in plain floats, from the corners too.
+    points = list(zip(x[1].tolist(), y[1].tolist(), strict=True))
+    assert [lazy.values_scalar(u, v) for u, v in points] == [built.values_scalar(u, v) for u, v in points]
+    assert [lazy.segment_scalar(u, v) for u, v in points] == [built.segment_scalar(u, v) for u, v in points]
     assert "cells" not in lazy.__dict__
     from orbit_env.decay.curves import CORNER_LOOKUPS
 
