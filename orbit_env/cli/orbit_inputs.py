@@ -378,17 +378,21 @@ def uncertainty(
     return None if low is None or high is None else (low, high)
 
 
+#: A band whose 95th percentile is shorter than this [days] is printed in days, not years.
+SHORT_BAND_DAYS = 730.0
+
+
 def uncertainty_lines(summary: dict[str, Any]) -> list[str]:
     """The text output's lines of ``--uncertainty``."""
-    days = summary["days_percentiles"]
-
-    def years(value: float | None) -> str:
-        return "beyond the propagation" if value is None else f"{value / 365.25:.2f}"
-
-    lines = [
-        f"lifetime 5/50/95%  {years(days['5'])} / {years(days['50'])} / {years(days['95'])} years "
-        f"({summary['uncertainty_samples']} samples, seed {summary['uncertainty_seed']})"
-    ]
+    values = [summary["days_percentiles"][k] for k in ("5", "50", "95")]
+    known = [value for value in values if value is not None]  # the percentiles beyond the propagation are last
+    if len(known) == 3 and known[2] < SHORT_BAND_DAYS:  # "0.08 / 0.09 / 0.12 years" would say little
+        band = " / ".join(f"{value:.1f}" for value in known) + " days"
+    else:
+        parts = [" / ".join(f"{value / 365.25:.2f}" for value in known) + " years"] if known else []
+        band = " / ".join(parts + ["beyond the propagation"] * (3 - len(known)))
+    samples = f"{summary['uncertainty_samples']} samples, seed {summary['uncertainty_seed']}"
+    lines = [f"lifetime 5/50/95%  {band} ({samples})"]
     dates = summary.get("reentry_date_percentiles")
     if dates:
         lines.append(f"re-entry 5-95%     {dates['5'] or '-'} to {dates['95'] or '-'}")

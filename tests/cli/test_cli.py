@@ -325,3 +325,19 @@ def test_fit_density_takes_the_msis_version(capsys, tmp_path):
     assert status == 0 and v00["atmosphere"].startswith("NRLMSISE-00, ")
     # The same decay in denser air takes a smaller scale: by the density ratio, 1/1.19 to 1/1.08.
     assert 0.80 < v00["scale"] / default["scale"] < 0.95
+
+
+@pytest.mark.parametrize(
+    ("percentiles", "expected"),
+    [
+        ({"5": 27.61, "50": 34.34, "95": 43.44}, "27.6 / 34.3 / 43.4 days"),  # a short band in days
+        ({"5": 3393.0, "50": 6669.5, "95": 12108.0}, "9.29 / 18.26 / 33.15 years"),
+        ({"5": 3393.0, "50": 6669.5, "95": None}, "9.29 / 18.26 years / beyond the propagation"),
+        ({"5": None, "50": None, "95": None}, " / ".join(["beyond the propagation"] * 3)),
+    ],
+)
+def test_the_band_is_in_days_when_it_is_short_and_in_years_otherwise(percentiles, expected):
+    from orbit_env.cli.orbit_inputs import uncertainty_lines
+
+    summary = {"days_percentiles": percentiles, "uncertainty_samples": 1000, "uncertainty_seed": 0}
+    assert uncertainty_lines(summary)[0] == f"lifetime 5/50/95%  {expected} (1000 samples, seed 0)"
