@@ -161,6 +161,25 @@ def test_lookups_before_the_cells_are_built_equal_those_after_bit_for_bit():
     np.testing.assert_array_equal(np.array(scalar).T, np.array(lazy.values(x[0], y[0])))
 
 
+def test_a_few_points_looked_up_one_by_one_equal_the_array_lookup_bit_for_bit():
+    from orbit_env.decay.curves import SCALAR_POINTS, BilinearGrid
+
+    # Up to SCALAR_POINTS points take values_scalar one by one; the floats must be the array path's.
+    rng = np.random.default_rng(2)
+    grid = BilinearGrid(rng.normal(size=(3, 50, 40)), 1.0, 0.5, -2.0, 0.25)
+    x, y = rng.uniform(-1.0, 30.0, 2 * SCALAR_POINTS), rng.uniform(-3.0, 10.0, 2 * SCALAR_POINTS)
+    whole = grid.values(x, y)  # more points than SCALAR_POINTS: the array path
+    for n in range(1, SCALAR_POINTS + 1):
+        few = grid.values(x[:n], y[:n])
+        assert all(a.shape == (n,) for a in few)
+        for a, b in zip(few, whole, strict=True):
+            np.testing.assert_array_equal(a, b[:n])
+    square = grid.values(x[:4].reshape(2, 2), y[:4].reshape(2, 2))  # any shape of a few points
+    np.testing.assert_array_equal(np.array(square), np.array(whole)[:, :4].reshape(3, 2, 2))
+    point = grid.values(np.float64(x[0]), np.float64(y[0]))  # 0-d in, 0-d out
+    assert point[0].shape == () and [float(v) for v in point] == [float(b[0]) for b in whole]
+
+
 @pytest.mark.usefixtures("forking")
 def test_curves_integrated_in_two_processes_are_the_curves_integrated_together(monkeypatch):
     """Half the curves in a forked child (`orbit_env.workers.in_two_processes`): the same numbers, bit for bit."""
