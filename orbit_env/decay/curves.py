@@ -177,9 +177,10 @@ class BilinearGrid:
     The cells (four times the tables' size) are built the first time something asks for
     them, or after `CORNER_LOOKUPS` lookups; until then ``values`` (and the scalar lookups)
     takes each point's four corners from the tables and forms the same coefficients by the
-    same operations, so the results are the same bit for bit either way. A decay under the real Sun visits tens of
-    bins' curves for a few lookups each, where building the cells would be most of its
-    time; the uncertainty's samples look a bin up thousands of times, where the cells pay.
+    same operations, so the results are the same bit for bit either way. A decay under the
+    real Sun visits tens of bins' curves for a few lookups each, where building the cells
+    would be most of its time; the uncertainty's samples look a bin up thousands of times,
+    where the cells pay.
     """
 
     def __init__(
