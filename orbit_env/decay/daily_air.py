@@ -114,6 +114,7 @@ class DailyAirTable:
         self._row_of: dict[DayKey, int] = {key: row for row, key in enumerate(map(_unpadded, self._keys.tolist()))}
         self._columns = _computed_columns(self._log_rho)  # per row: its leading columns NRLMSIS has filled
         self._stored_rows = self._read_rows = len(self._row_of)
+        self._deepened: set[int] = set()  # rows read from the disk cache that this process has deepened
         self._changes = 0  # rows added or deepened since the table was last written (or read)
         self._pending: tuple[list[DayKey], Forked] | None = None  # rows a forked process computes
         _TABLES.add(self)
@@ -246,8 +247,14 @@ class DailyAirTable:
         return heights, self.inclination_deg, node, self.version, self.latitude_nodes, self.local_time_nodes
 
     def new_rows(self) -> tuple[list[DayKey], FloatArray]:
-        """The keys and rows this process added to the table since it read it from the disk cache."""
-        return list(self._row_of)[self._read_rows :], self._log_rho[self._read_rows :]
+        """The keys and rows this process added to the table since it read it from the disk cache, or deepened.
+
+        A row read shallow (computed for a lower orbit) and deepened here is handed back too: else a
+        worker would deepen it again on every run.
+        """
+        keys = list(self._row_of)  # in row order: rows are only appended
+        rows = [*sorted(self._deepened), *range(self._read_rows, len(keys))]
+        return [keys[row] for row in rows], self._log_rho[rows]
 
     def merge(self, keys: Sequence[DayKey], log_rho: FloatArray) -> None:
         """Hold rows computed here or by another process (`new_rows` of a worker's table).
@@ -271,6 +278,8 @@ class DailyAirTable:
             row = self._row_of[tuple(keys[k])]
             self._log_rho[row] = log_rho[k]
             self._columns[row] = columns[k]
+            if row < self._read_rows:
+                self._deepened.add(row)
         self._changes += len(fresh) + len(deeper)
         if self._changes and self._stored_rows + self._changes >= STORE_GROWTH * self._stored_rows:
             self.store()
