@@ -48,6 +48,14 @@ def one_lifetime(height_km: str) -> list[str]:
     return [sys.executable, "-m", "orbit_env.cli", "lifetime", *orbit, *SATELLITE, "--epoch", EPOCH]
 
 
+def run(command: list[str], env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """Run a command, its output captured; on a failure, its error output printed and the benchmark stopped."""
+    done = subprocess.run(command, capture_output=True, text=True, env=env)
+    if done.returncode:
+        sys.exit(f"failed ({done.returncode}): {' '.join(command)}\n{done.stderr}")
+    return done
+
+
 def timed(command: list[str], env: dict[str, str], repeats: int) -> tuple[float, float]:
     """Median wall time and median CPU time (user + system) of a whole process [s].
 
@@ -60,7 +68,7 @@ def timed(command: list[str], env: dict[str, str], repeats: int) -> tuple[float,
     for _ in range(repeats):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
-        subprocess.run(command, check=True, capture_output=True, env=env)
+        run(command, env)
         walls.append(time.perf_counter() - start)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpus.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
@@ -93,7 +101,7 @@ def main() -> None:
     for height in args.perigees:
         one_command = one_lifetime(height)
         print(f"orbit: {' '.join(one_command[3:])}")
-        subprocess.run([*one_command, *SAMPLES], check=True, capture_output=True, env=env)  # warm the disk cache
+        run([*one_command, *SAMPLES], env)  # warm the disk cache
         one = timed(one_command, env, args.repeats)
         spread = timed([*one_command, *SAMPLES], env, args.repeats)
         report(f"whole processes, disk cache warm, medians of {args.repeats}:", one, spread)
@@ -104,9 +112,7 @@ def main() -> None:
                 timed(one_command, cold[0], 1),
                 timed([*one_command, *SAMPLES], cold[1], 1),
             )
-        out = subprocess.run(
-            [*one_command, *SAMPLES, "--rule", "5"], check=True, capture_output=True, text=True, env=env
-        )
+        out = run([*one_command, *SAMPLES, "--rule", "5"], env)
         print(f"$ orbit-env lifetime {' '.join([*one_command[4:], *SAMPLES, '--rule', '5'])}")
         print(out.stdout, end="")
 
