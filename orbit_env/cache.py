@@ -23,6 +23,7 @@ Control:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import hashlib
@@ -30,10 +31,18 @@ import os
 import shutil
 import tempfile
 import zipfile
+from collections.abc import Iterator
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import numpy as np
+
+fcntl: ModuleType | None
+try:
+    import fcntl
+except ImportError:  # not POSIX: `locked` does not lock
+    fcntl = None
 
 #: The environment variable that moves (a folder) or disables (``off``) the cache.
 ENV_VAR = "ORBIT_ENV_CACHE_DIR"
@@ -168,6 +177,26 @@ def store(
             raise
     except OSError:
         return
+
+
+@contextlib.contextmanager
+def locked(kind: str, description: str | None) -> Iterator[None]:
+    """Hold a table's lock file (``<name>.lock`` beside it) for a block: for a read, merge and write of one table.
+
+    An exclusive ``flock`` where the platform has one (POSIX); elsewhere, or where the lock file
+    cannot be made (no cache, a read-only folder), the block runs unlocked: the write stays atomic,
+    and the worst case is a table that misses the rows of a process that wrote at the same moment.
+    """
+    path = None if description is None else _path(kind, description)
+    with contextlib.ExitStack() as stack:
+        if path is not None and fcntl is not None:
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                handle = stack.enter_context(path.with_suffix(".lock").open("a"))
+                fcntl.flock(handle, fcntl.LOCK_EX)  # released when the file is closed
+            except OSError:
+                pass  # unlocked (see above)
+        yield
 
 
 def _store_folder(folder: Path, arrays: dict[str, np.ndarray]) -> None:

@@ -263,6 +263,12 @@ class DailyAirTable:
         columns it had are NRLMSIS's same values); the table is written when it has changed by
         a quarter.
         """
+        self._changes += self._hold(keys, log_rho)
+        if self._changes and self._stored_rows + self._changes >= STORE_GROWTH * self._stored_rows:
+            self.store()
+
+    def _hold(self, keys: Sequence[DayKey], log_rho: FloatArray) -> int:
+        """`merge`'s rows taken in, without writing: how many were added or deepened."""
         log_rho = np.asarray(log_rho)
         columns = _computed_columns(log_rho)
         fresh, deeper = [], []
@@ -280,16 +286,23 @@ class DailyAirTable:
             self._columns[row] = columns[k]
             if row < self._read_rows:
                 self._deepened.add(row)
-        self._changes += len(fresh) + len(deeper)
-        if self._changes and self._stored_rows + self._changes >= STORE_GROWTH * self._stored_rows:
-            self.store()
+        return len(fresh) + len(deeper)
 
     def store(self) -> None:
-        """Write the table to the disk cache if it holds rows not written yet."""
+        """Write the table to the disk cache if it holds rows not written yet.
+
+        With the rows another process has written since this one read the table taken in first
+        (under the table's lock, `orbit_env.cache.locked`): the catalogue's worker processes each
+        write their table as they end, and a plain write would keep only the last one's rows.
+        """
         if self._changes:
-            # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
-            arrays = {"keys": self._keys, "log_density": self._log_rho}
-            cache.store("airdays", self._description, arrays, compress=False)
+            with cache.locked("airdays", self._description):
+                stored = cache.load("airdays", self._description)
+                if stored is not None:
+                    self._hold(list(map(_unpadded, stored["keys"].tolist())), stored["log_density"])
+                # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
+                arrays = {"keys": self._keys, "log_density": self._log_rho}
+                cache.store("airdays", self._description, arrays, compress=False)
             self._stored_rows = len(self)
             self._changes = 0
 
