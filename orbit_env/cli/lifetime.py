@@ -57,10 +57,19 @@ def _satellite(args: argparse.Namespace) -> Satellite:
     return make_satellite(cx, args.mass, args.area, args.mass_per_area)
 
 
-def _atmosphere(args: argparse.Namespace, scenario: Scenario) -> str:
-    """The atmosphere line; says so when the inclination it depends on is the default, not the user's."""
+def _atmosphere(args: argparse.Namespace, scenario: Scenario, *, batch: bool = False) -> str:
+    """The atmosphere line; says so when the inclination it depends on is the default, not the user's.
+
+    With ``batch``, the inclination is each row's (its ``inclination_deg``), ``--inclination`` only
+    where a row gives none: the line says so, where the scenario's one inclination would mislead.
+    """
     text = scenario.describe(args.inclination)
-    if scenario.depends_on_inclination and getattr(args, "inclination_defaulted", False):
+    defaulted = scenario.depends_on_inclination and getattr(args, "inclination_defaulted", False)
+    if batch and scenario.depends_on_inclination:
+        default = "the default, no --inclination given" if defaulted else "--inclination"
+        rows = f"each row's inclination_deg ({args.inclination:g} deg where a row has none: {default})"
+        return text.replace(f"inclination {args.inclination:g} deg", rows)
+    if defaulted:
         text += " (the default: no --inclination given)"
     return text
 
@@ -257,7 +266,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
     elapsed = time.perf_counter() - start
     print(
         f"wrote {rows} rows to {args.out} ({ok} with lifetimes, {rows - ok} with a "
-        f"status message) in {elapsed:.2f} s; atmosphere {_atmosphere(args, scenario)}"
+        f"status message) in {elapsed:.2f} s; atmosphere {_atmosphere(args, scenario, batch=True)}"
     )
     if ok == rows:
         return 0

@@ -297,6 +297,21 @@ def test_nrlmsis_says_when_the_inclination_is_not_the_users(capsys):
     assert "inclination 97.8 deg" in out and "no --inclination given" not in out
 
 
+def test_a_batch_under_nrlmsis_says_each_row_has_its_own_inclination(capsys, tmp_path):
+    # The rows' inclination_deg, not --inclination's one value, set each row's air: the line says so.
+    sats = tmp_path / "sats.csv"
+    sats.write_text("perigee_km,apogee_km,inclination_deg\n300,400,97.5\n300,400,\n")
+    for extra, default in (
+        ((), "0 deg where a row has none: the default, no --inclination given"),
+        (("--inclination", "51.6"), "51.6 deg where a row has none: --inclination"),
+    ):
+        out = tmp_path / f"out{len(extra)}.csv"
+        status, stdout, _ = run(capsys, "lifetime", "--batch", sats, "--out", out, "--atmosphere", "msis", *extra)
+        assert status == 0
+        assert f"each row's inclination_deg ({default})" in stdout
+        assert "inclination 0 deg" not in stdout and "(the default: no --inclination given)" not in stdout
+
+
 def test_a_solar_table_that_ends_early_is_named_with_its_dates(capsys, tmp_path):
     table = tmp_path / "two_weeks.csv"
     table.write_text("date,f107\n" + "".join(f"2013-10-{d:02d},120\n" for d in range(1, 15)))
