@@ -179,6 +179,20 @@ def store(
         return
 
 
+def stamp(kind: str, description: str | None) -> tuple[int, int] | None:
+    """The stored table's file identity (inode, modification time [ns]), None if there is none.
+
+    Every write replaces the file (a new inode), so an unchanged stamp says no process has
+    written the table since: a process that merges before it writes (`locked`) need not read it.
+    """
+    path = None if description is None else _path(kind, description)
+    try:
+        status = None if path is None else path.stat()
+    except OSError:
+        return None
+    return None if status is None else (status.st_ino, status.st_mtime_ns)
+
+
 @contextlib.contextmanager
 def locked(kind: str, description: str | None) -> Iterator[None]:
     """Hold a table's lock file (``<name>.lock`` beside it) for a block: for a read, merge and write of one table.

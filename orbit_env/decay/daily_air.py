@@ -105,6 +105,7 @@ class DailyAirTable:
                 local_time_nodes,
             )
         )
+        self._disk = cache.stamp("airdays", self._description)  # the file read (`store` reads it again if replaced)
         stored = cache.load("airdays", self._description)
         if stored is None:
             self._keys = np.empty((0, 4))
@@ -297,12 +298,14 @@ class DailyAirTable:
         """
         if self._changes:
             with cache.locked("airdays", self._description):
-                stored = cache.load("airdays", self._description)
-                if stored is not None:
-                    self._hold(list(map(_unpadded, stored["keys"].tolist())), stored["log_density"])
+                if cache.stamp("airdays", self._description) != self._disk:  # another process wrote it
+                    stored = cache.load("airdays", self._description)
+                    if stored is not None:
+                        self._hold(list(map(_unpadded, stored["keys"].tolist())), stored["log_density"])
                 # Uncompressed: read back in milliseconds (a solar cycle's days are about 1 MB).
                 arrays = {"keys": self._keys, "log_density": self._log_rho}
                 cache.store("airdays", self._description, arrays, compress=False)
+                self._disk = cache.stamp("airdays", self._description)
             self._stored_rows = len(self)
             self._changes = 0
 

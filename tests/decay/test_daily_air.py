@@ -163,6 +163,27 @@ def test_two_processes_writing_one_table_keep_both_their_rows(tmp_path, monkeypa
     assert calls == []
 
 
+def test_a_table_no_other_process_wrote_is_not_read_again_before_a_write(tmp_path, monkeypatch):
+    # `store` takes in what other processes wrote; where the file is the one this process read or
+    # wrote last (the same inode and time), it writes without reading it (a cold run writes often).
+    air = table(tmp_path, monkeypatch)
+    air.log_density(KEYS[:1])
+    air.store()
+    loads = []
+    original = cache.load
+    monkeypatch.setattr(cache, "load", lambda *a, **k: loads.append(a[0]) or original(*a, **k))
+    air.log_density(KEYS[1:2])
+    air.store()
+    assert loads == []
+    other = table(tmp_path, monkeypatch)  # reads the file (one load)
+    other.log_density(KEYS[2:])
+    other.store()
+    air.log_density([(100.0, 100.0, 8.0, 200.0)])  # a new row: the file is now the other's, so it is read first
+    air.store()
+    assert loads.count("airdays") == 2
+    assert len(table(tmp_path, monkeypatch)) == 4
+
+
 def test_rows_a_worker_deepened_go_back_to_its_parent(tmp_path, monkeypatch):
     """A row read shallow from the disk cache and deepened in a worker is in the worker's `new_rows`.
 
