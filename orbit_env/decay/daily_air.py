@@ -24,9 +24,11 @@ whose scaled forecasts are days never seen, rewrote a growing table hundreds of 
 The rows are NRLMSIS's own values for those indices (a memo, not an interpolation), so
 results do not change with what is cached. A caller may ask for the first heights only
 (``columns``: a decay reads no air above its orbits): a row is then computed to those heights,
-NaN above, and deepened when a later caller asks for more. Worker processes (the uncertainty's solar
-nodes) hand the rows they computed back to their parent (`new_rows`, `merge_rows`), which
-writes them with its own: two processes writing one table would keep only one's rows.
+NaN above, and deepened when a later caller asks for more. Forked worker processes (the uncertainty's
+solar nodes) hand the rows they computed or deepened back to their parent (`new_rows`, `merge_rows`),
+which writes them with its own. Processes that each write (the catalogue's spawned workers, two
+commands at once) write under the table's lock (`orbit_env.cache.locked`), each taking in first the
+rows the others wrote since it read the table: none loses another's rows.
 Units: SI (m, kg/m^3).
 
 **Storm days.** A day the decay counts as a storm day (`orbit_env.decay.chunked.STORM_AP`)

@@ -133,8 +133,7 @@ def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_a
 ):
     # --workers runs the solar nodes after the first in worker processes (forked where this process may fork,
     # else spawned): the same lifetimes bit for bit, and the rows of the real Sun's air they computed come back
-    # to this process's tables (else the next run would compute them again: two processes writing one table on
-    # disk keep one's rows).
+    # to this process's tables (else the next run would compute them again: a forked worker writes no table).
     pytest.importorskip("pymsis")
     from orbit_env import workers
     from orbit_env.decay import daily_air
