@@ -27,7 +27,9 @@ Modes, both through the package's command line run in-process
   set's epoch up to it, the chosen set last; where there are more than 30, 30 evenly spaced in file
   order, always keeping the oldest and the chosen one. A history of one set is not run ("one set
   only"). A command that refuses several sets without ``--batch`` (exit status 2, "... use --batch ...")
-  makes the case "history not supported" rather than an error.
+  makes the case "history not supported" rather than an error; one whose sets give no fit (no two a
+  day apart: the command then predicts from the latest set alone, as in the one-set mode) "no history
+  fit".
 
 With ``--uncertainty`` (default on) the same run adds ``--uncertainty --samples N``: the prediction is
 read from ``days`` and the 90% band from ``reentry_date_percentiles`` ("5" to "95"), counted from the
@@ -78,6 +80,8 @@ BUCKETS = ((0.0, 30.0, "<30 d"), (30.0, 180.0, "30-180 d"), (180.0, math.inf, ">
 MODES = ("one set", "history")
 #: Status of a case whose history the command line does not accept yet.
 HISTORY_NOT_SUPPORTED = "history not supported"
+#: Status of a history case whose sets gave no fit: the command predicted from the latest set alone.
+NO_HISTORY_FIT = "no history fit"
 
 
 @dataclass(frozen=True)
@@ -359,6 +363,9 @@ def predict(
         if mode == "history" and status == 2 and "--batch" in message:
             return Case(**base, status=HISTORY_NOT_SUPPORTED, seconds=seconds)
         return Case(**base, status=f"error: {message or f'exit status {status}'}", seconds=seconds)
+    if mode == "history" and summary.get("drag_parameter_source") != "history_fit":
+        # No fit (no two sets a day apart): the command predicted from the latest set alone, the one-set case.
+        return Case(**base, status=NO_HISTORY_FIT, seconds=seconds)
     # The prediction counts from the epoch the command used (the chosen set's, to the second).
     offset = days_between(epoch, parse_date(summary["epoch"])) if summary.get("epoch") else 0.0
     band = (math.nan, math.nan)

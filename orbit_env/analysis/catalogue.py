@@ -212,12 +212,27 @@ def batch_lifetimes(
     rule_years: float | None = None,
     progress: bool = True,
     exact_groups: bool = False,
+    epoch_days: FloatArray | None = None,
 ) -> tuple[list[dict[str, Any]], BatchSummary]:
     """Lifetimes (and the rule check) of every valid row; output records in input order.
 
     ``exact_groups`` builds a curve family per inclination group however many there
     are (the reference the one-family path of a spread catalogue is measured against).
+    ``epoch_days`` (a dated ``scenario`` only): each row's own start [unix days], the
+    epoch of its object's latest element set; the rows of each date run in the scenario
+    moved to it (`Scenario.at_epoch`), and the records gain ``epoch`` and ``reentry_date``.
     """
+    if epoch_days is not None:
+        return _from_own_epochs(
+            rows,
+            (perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg),
+            status,
+            scenario,
+            epoch_days,
+            rule_years=rule_years,
+            progress=progress,
+            exact_groups=exact_groups,
+        )
     n = len(rows)
     ok = np.array([s == "ok" for s in status])
     days = np.full(n, np.nan)
@@ -306,3 +321,44 @@ def batch_lifetimes(
         records.append(record)
     n_ok = sum(1 for s in status if s == "ok")
     return records, BatchSummary(rows=n, ok=n_ok, groups=len(families))
+
+
+def _from_own_epochs(
+    rows: Sequence[dict[str, str]],
+    inputs: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    status: list[str],
+    scenario: Scenario,
+    epoch_days: FloatArray,
+    **options: Any,
+) -> tuple[list[dict[str, Any]], BatchSummary]:
+    """`batch_lifetimes` of the rows of each date in the scenario moved to it; the records in input order."""
+    from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
+
+    from orbit_env.analysis.lifetime import iso_datetime
+
+    progress = options.pop("progress")
+    records: list[dict[str, Any]] = [{} for _ in rows]
+    groups = 0
+    valid = np.array([s == "ok" for s in status])
+    dates = np.unique(epoch_days[valid]) if valid.any() else np.array([])
+    with tqdm(total=int(valid.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
+        # Rows with no lifetime to compute go with the first date: their records say why.
+        for k, date in enumerate(dates if dates.size else [np.nan]):
+            members = np.flatnonzero((epoch_days == date) | (~valid if k == 0 else False))
+            part, summary = batch_lifetimes(
+                [rows[i] for i in members],
+                *(x[members] for x in inputs),
+                [status[i] for i in members],
+                scenario if np.isnan(date) else scenario.at_epoch(float(date)),
+                progress=False,
+                **options,
+            )
+            groups += summary.groups
+            for i, record in zip(members, part, strict=True):
+                days = record.get("days", "")
+                record_date = {"epoch": iso_datetime(float(epoch_days[i])) if np.isfinite(epoch_days[i]) else ""}
+                record_date["reentry_date"] = iso_datetime(float(epoch_days[i]) + float(days)) if days else ""
+                status[i] = record.pop("status")
+                records[i] = {**record, **record_date, "status": status[i]}
+            bar.update(int(valid[members].sum()))
+    return records, BatchSummary(rows=len(rows), ok=sum(s == "ok" for s in status), groups=groups)

@@ -57,6 +57,7 @@ def uncertain_lifetimes(
     seed: int,
     rule_years: float | None = None,
     dated: bool = False,
+    own_epochs: bool = False,
 ) -> list[dict[str, Any]]:
     """The batch's records (`batch_lifetimes`) with each valid row's percentiles and rule probability.
 
@@ -68,6 +69,8 @@ def uncertain_lifetimes(
         rule_years: A disposal rule: add its probability and verdict.
         dated: Add the re-entry dates' columns (the air has a date, or the rows have epochs);
             a row's dates count from the air's epoch, else from its own.
+        own_epochs: Each row's air (a dated ``scenario``) starts at the row's own epoch
+            (`batch_lifetimes`'s ``epoch_days``: a batch of element sets), and so do its dates.
     """
     records, _ = batch_lifetimes(
         orbits.rows,
@@ -80,6 +83,7 @@ def uncertain_lifetimes(
         rule_years=rule_years,
         progress=False,
         exact_groups=True,
+        epoch_days=orbits.epoch_days if own_epochs else None,
     )
     for i, record in enumerate(records):
         status = record.pop("status")
@@ -90,7 +94,8 @@ def uncertain_lifetimes(
             columns.update(compliance_probability="", complies_with_confidence="")
         columns["uncertainty_seed"] = ""
         if status == "ok":
-            columns.update(_row_columns(orbits, i, scenario, samples, seed, rule_years, dated))
+            air = scenario.at_epoch(float(orbits.epoch_days[i])) if own_epochs else scenario
+            columns.update(_row_columns(orbits, i, air, samples, seed, rule_years, dated))
         record.update(columns, status=status)
     return records
 

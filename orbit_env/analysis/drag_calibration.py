@@ -195,6 +195,13 @@ class DragFit:
         }
 
 
+class NoHistoryToFit(ValueError):
+    """A history with fewer than two sets a day apart within `HISTORY_SPAN_DAYS` of its latest: nothing to fit.
+
+    Its latest set alone still gives the drag (`calibrate`), which is what the callers fall back on.
+    """
+
+
 def fit_history(history: list[Any], scenario: Any) -> DragFit:
     """Fit c to the decay between the sets of one object (oldest first), in ``scenario``'s air.
 
@@ -205,8 +212,9 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     `HISTORY_SPAN_DAYS` before the latest are left out.
 
     Raises:
-        ValueError: fewer than two sets in the span, sets of different objects, or no decay
-            between them (the semi-major axis does not fall: a manoeuvre, or too short a span).
+        NoHistoryToFit: fewer than two sets a day apart in the span.
+        ValueError: sets of different objects, or no decay between them (the semi-major
+            axis does not fall: a manoeuvre, or too short a span).
     """
     numbers = sorted({s.catalogue_number for s in history})
     if len(numbers) > 1:
@@ -214,7 +222,7 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     latest = max(s.epoch_days for s in history)
     sets = sorted((s for s in history if latest - s.epoch_days <= HISTORY_SPAN_DAYS), key=lambda s: s.epoch_days)
     if len(sets) < 2 or sets[-1].epoch_days - sets[0].epoch_days < HISTORY_STEP_DAYS:
-        raise ValueError(
+        raise NoHistoryToFit(
             f"a drag fit needs sets at least a day apart within {HISTORY_SPAN_DAYS:g} days of the latest; "
             f"{len(sets)} set(s) there"
         )

@@ -25,6 +25,7 @@ from orbit_env.analysis.drag_calibration import (
     SOURCE_BSTAR_CALIBRATED,
     SOURCE_HISTORY_FIT,
     SOURCE_NDOT_CALIBRATED,
+    NoHistoryToFit,
     calibrate,
     fit_history,
 )
@@ -130,15 +131,23 @@ def drag_source(
                 body, sphere_heights_km, inclination_deg, scenario, ascending_node_local_time_h
             )
         return DragSource(make_satellite(cx, inputs.mass_kg, body.reference_area_m2), SOURCE_SHAPE, report)
+    no_fit = None
     if not inputs.given and history is not None:
         if inputs.drag_from is not None:
             raise ValueError("--drag-from chooses what one element set gives; a history's drag is fitted to its decay")
-        fit = fit_history(history, scenario)
-        return DragSource(Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, {"drag_fit": fit.report()})
+        try:
+            fit = fit_history(history, scenario)
+        except NoHistoryToFit as why:  # the latest set alone, as for a file of one set, and the report says why
+            no_fit = f"no history fit: {why}; from the latest set alone"
+        else:
+            report = {"drag_fit": fit.report()}
+            return DragSource(Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, report)
     if not inputs.given and elements is not None and elements.bstar_per_earth_radius is not None:
         c, source, calibration_report = drag_from_elements(elements, scenario, inputs.drag_from or DRAG_FROM_DEFAULT)
         report = {"bstar_per_earth_radius": elements.bstar_per_earth_radius, "ndot_rev_day2": elements.ndot_rev_day2}
         report.update(calibration_report)
+        if no_fit is not None:
+            report["drag_note"] = no_fit
         # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
         return DragSource(Satellite(1.0, 1.0, c), source, report)
     satellite = make_satellite(cx, inputs.mass_kg, inputs.area_m2, inputs.mass_per_area_kg_m2)
@@ -251,8 +260,13 @@ def element_set_orbits(
         if satellite_given:
             continue
         try:
+            fit = None
             if len(history) > 1:
-                fit = fit_history(history, scenario)
+                try:
+                    fit = fit_history(history, scenario)
+                except NoHistoryToFit:  # the latest set alone, as for an object of one set
+                    fit = None
+            if fit is not None:
                 c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
             else:
                 calibration = calibrate(s, scenario)

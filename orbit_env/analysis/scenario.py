@@ -129,6 +129,16 @@ class Scenario:
             max_years=self.max_years if max_years is None else max_years,
         )
 
+    def at_epoch(self, epoch_days: float) -> Scenario:
+        """The same dated air from another date [unix days] (each object of a batch of element sets from its own).
+
+        Raises:
+            ValueError: the air has no date.
+        """
+        if not self.time_varying:
+            raise ValueError("only a dated air starts at another date")
+        return replace(self, air=replace(self.air, epoch_days=float(epoch_days)))
+
     def in_sphere_heights(self, reference: str, inclination_deg: float) -> Scenario:
         """The scenario for heights above the 6371 km sphere when the user's are above ``reference``."""
         air = self.air.in_sphere_heights(reference, inclination_deg)

@@ -61,13 +61,19 @@ def _atmosphere(args: argparse.Namespace, scenario: Scenario, *, batch: bool = F
     """The atmosphere line; says so when the inclination it depends on is the default, not the user's.
 
     With ``batch``, the inclination is each row's (its ``inclination_deg``), ``--inclination`` only
-    where a row gives none: the line says so, where the scenario's one inclination would mislead.
+    where a row gives none: the line says so, where the scenario's one inclination would mislead;
+    so does the date of a batch of element sets, each row's air from its own epoch.
     """
     text = scenario.describe(args.inclination)
+    if batch and getattr(args, "rows_own_epochs", False) and scenario.epoch_days is not None:
+        own = "from each row's epoch (its latest element set) in"
+        text = text.replace(f"from {iso_date(scenario.epoch_days)} in", own)
     defaulted = scenario.depends_on_inclination and getattr(args, "inclination_defaulted", False)
     if batch and scenario.depends_on_inclination:
         default = "the default, no --inclination given" if defaulted else "--inclination"
         rows = f"each row's inclination_deg ({args.inclination:g} deg where a row has none: {default})"
+        if getattr(args, "batch_element_sets", False):
+            rows = "each row's inclination (its element set's)"
         return text.replace(f"inclination {args.inclination:g} deg", rows)
     if defaulted:
         text += " (the default: no --inclination given)"
@@ -256,6 +262,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             air,
             rule_years=args.rule,
             progress=not args.no_progress,
+            epoch_days=orbits.epoch_days if getattr(args, "rows_own_epochs", False) else None,
         )
         write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
         rows, ok = summary.rows, summary.ok

@@ -109,7 +109,9 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
 
     Sets ``args.atmosphere`` (msis when there is an epoch and no ``--atmosphere``, else
     paper), ``args.epoch`` (a TLE's, unless given), ``args.inclination`` (a TLE's, else 0)
-    and ``args.height_reference``.
+    and ``args.height_reference``. A ``--batch`` of element sets without ``--epoch`` sets
+    ``args.rows_own_epochs``: each row's air starts at its object's latest set
+    (`orbit_env.analysis.catalogue.batch_lifetimes`'s ``epoch_days``).
     """
     elements = None
     tle = getattr(args, "tle", None)
@@ -146,6 +148,16 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         if perigee is not None or apogee is not None:
             raise ValueError("give either --perigee/--apogee or --semi-major-axis-km/--eccentricity, not both")
         elements = mean_elements(mean_a, ecc, 0.0 if args.inclination is None else args.inclination)
+    if getattr(args, "batch", None):
+        from orbit_env.analysis.elements import looks_like_tle, read_tle
+
+        args.batch_element_sets = looks_like_tle(args.batch)
+        dated = "epoch" in air_model(args.atmosphere or DATED_AIR).options
+        # A batch of element sets: each object from its own latest set's epoch, as --tle starts from its set's.
+        if args.batch_element_sets and args.epoch is None and dated:
+            first = min(read_tle(args.batch), key=lambda s: s.epoch_days)
+            args.epoch = first.epoch_iso.rstrip("Z")  # dates the air; each row moves it to its own
+            args.rows_own_epochs = True
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:
@@ -254,11 +266,12 @@ def satellite_line(drag: DragSource) -> str:
         )
     if "sgp4_to_air_density_ratio" in report:
         what = "B*" if source == SOURCE_BSTAR_CALIBRATED else "ndot"
+        note = f" ({report['drag_note']})" if "drag_note" in report else ""
         return (
             f"satellite          c_x A/m = {c:.4g} m^2/kg from one element set's {what}, calibrated to this air at its "
             f"epoch (SGP4's density {report['sgp4_to_air_density_ratio']:.3g} x this air's; 2 B*/rho0 = "
             f"{report['drag_parameter_uncalibrated_m2_kg']:.4g}); one set: uncertain by a factor of "
-            f"{math.exp(ONE_SET_DRAG_SIGMA):.2g} (1 sigma)"
+            f"{math.exp(ONE_SET_DRAG_SIGMA):.2g} (1 sigma){note}"
         )
     text = (
         f"satellite          c_x {satellite.drag_coefficient:.4g}, {satellite.mass_kg:g} kg, "

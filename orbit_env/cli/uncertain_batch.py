@@ -41,6 +41,7 @@ class ChunkRecords:
     rule_years: float | None
     dated: bool
     height_reference: str
+    own_epochs: bool = False
 
     def __call__(self, start: int, stop: int) -> list[dict[str, Any]]:
         """The records of rows ``start`` to ``stop``, heights above the command's reference."""
@@ -51,6 +52,7 @@ class ChunkRecords:
             seed=self.seed,
             rule_years=self.rule_years,
             dated=self.dated,
+            own_epochs=self.own_epochs,
         )
         return records_in_reference(records, self.height_reference)
 
@@ -94,6 +96,7 @@ def run(args: argparse.Namespace, orbits: BatchOrbits, scenario: Scenario) -> Jo
         None if args.rule is None else float(args.rule),
         scenario.epoch_days is not None or bool(np.isfinite(orbits.epoch_days).any()),
         args.height_reference,
+        bool(getattr(args, "rows_own_epochs", False)),
     )
     return run_in_parts(
         args.out,

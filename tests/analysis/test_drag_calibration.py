@@ -183,6 +183,78 @@ def test_several_objects_in_one_file_are_an_error_naming_them(capsys, tmp_path):
     assert "2 objects (41460, 41619)" in err and "--batch" in err
 
 
+@pytest.mark.parametrize("uncertainty", [False, True])
+def test_a_batch_of_element_sets_starts_each_object_at_its_own_epoch_in_the_real_suns_air(
+    capsys, tmp_path, uncertainty
+):
+    # What --tle does for one object, --batch does for each: NRLMSIS under the record's Sun from the object's
+    # latest set (the paper's undated air was the batch's default), each object's sets its history.
+    import csv
+
+    from orbit_env.analysis.lifetime import iso_datetime
+    from orbit_env.cli import main
+
+    beesat, beesat_latest = real_sets(41619, -1, 4)  # a history of four sets (the how-to's example)
+    other, other_latest = real_sets(41460, -1, 1)  # AAUSAT 4, one set: B* calibrated
+    path = tmp_path / "two.tle"
+    path.write_text(beesat + other)
+    out = tmp_path / "out.csv"
+    extra = ["--uncertainty", "--samples", "20", "--workers", "1"] if uncertainty else []
+    status = main(["lifetime", "--batch", str(path), "--out", str(out), "--no-progress", *extra])
+    text, _ = capsys.readouterr()
+    assert status == 0
+    assert "NRLMSIS 2.1, CelesTrak space weather" in text and "from each row's epoch (its latest element set)" in text
+    rows = {row["name"]: row for row in csv.DictReader(out.open())}
+    for latest, sets in ((beesat_latest, beesat), (other_latest, other)):
+        one = tmp_path / f"{latest.catalogue_number}.tle"
+        one.write_text(sets)
+        _, single, _ = run_json(capsys, "--tle", str(one))
+        row = rows[latest.name]
+        assert single["drag_parameter_source"] in ("history_fit", "bstar_calibrated")
+        # The same drag parameter (the same calibration or fit, in the same air at the same dates).
+        assert float(row["drag_parameter_m2_kg"]) == pytest.approx(single["drag_parameter_m2_kg"], rel=1e-5)
+        # The same decay but for the batch's inclination groups (INCLINATION_STEP_DEG; measured 0.06-0.08% on
+        # two 2013 objects): within 0.5%.
+        assert float(row["days"]) == pytest.approx(single["days"], rel=5e-3)
+        assert row["epoch"] == iso_datetime(latest.epoch_days)
+        assert row["reentry_date"] == iso_datetime(latest.epoch_days + float(row["days"]))
+        if uncertainty:
+            assert row["reentry_date_p5"] < row["reentry_date_p50"] < row["reentry_date_p95"]
+            assert row["reentry_date_p5"] > row["epoch"]
+
+
+def test_a_history_with_no_set_near_its_latest_falls_back_on_the_latest_set_and_says_so(capsys, tmp_path):
+    # AggieSat 4's file: its latest set (2018-02-15) has no other within HISTORY_SPAN_DAYS, so there is no
+    # decay to fit. The prediction is the latest set's alone (B* calibrated), as from a file of that set,
+    # and the report says why (it was an error, in a batch a row without a lifetime).
+    import csv
+
+    from orbit_env.analysis.drag_calibration import NoHistoryToFit
+    from orbit_env.analysis.elements import read_tle
+    from orbit_env.cli import main
+
+    path = next(DATA.glob("41313_*.tle"))
+    sets = read_tle(path)
+    assert len(sets) > 1
+    with pytest.raises(NoHistoryToFit):
+        fit_history(sets, Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0))))
+    latest, _ = real_sets(41313, -1, 1)
+    one = tmp_path / "latest.tle"
+    one.write_text(latest)
+    status, history, _ = run_json(capsys, "--tle", str(path))
+    _, alone, _ = run_json(capsys, "--tle", str(one))
+    assert status == 0 and history["drag_parameter_source"] == "bstar_calibrated"
+    assert history["drag_note"].startswith("no history fit: a drag fit needs sets at least a day apart")
+    assert history["days"] == alone["days"] and "drag_note" not in alone
+    out = tmp_path / "out.csv"
+    assert main(["lifetime", "--batch", str(path), "--out", str(out), "--no-progress"]) == 0
+    (row,) = csv.DictReader(out.open())
+    # The file's numbers carry six digits.
+    assert row["status"] == "ok" and float(row["drag_parameter_m2_kg"]) == pytest.approx(
+        alone["drag_parameter_m2_kg"], rel=1e-5
+    )
+
+
 @pytest.mark.slow
 def test_real_reentries_from_element_sets_meet_the_goals():
     # benchmarks/validate_element_sets.py over the 32 objects (72 cases, ~13 minutes on 2 cores): measured
