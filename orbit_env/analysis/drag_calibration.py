@@ -161,6 +161,9 @@ def calibrate(elements: Any, scenario: Any, *, source: str = SOURCE_BSTAR_CALIBR
 #: Sets of a history further back than this before the latest are not fitted [days]: the satellite's
 #: attitude and the air change over months, and the prediction starts from the latest set.
 HISTORY_SPAN_DAYS = 90.0
+#: Steps of a history fit from which a forked child computes half of them (`orbit_env.workers.in_two_processes`):
+#: a step's air costs about 30 ms (NRLMSIS over the orbit on `FIT_SPAN_DAYS` days), a fork 5-15 ms.
+FIT_FORK_MIN_STEPS = 4
 #: The integration step of a history fit [days].
 HISTORY_STEP_DAYS = 1.0
 
@@ -234,12 +237,20 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     grid = np.linspace(t[0], t[-1], steps + 1)
     middle = 0.5 * (grid[1:] + grid[:-1])
     a_path = np.interp(middle, t, a_m)
-    rate = np.array(
-        [
-            a * a / MU_EARTH_M3_S2 * air_drag_rate(scenario, a, e, inclination, day)
-            for a, day in zip(a_path, middle, strict=True)
-        ]
-    )
+
+    def rates(days: slice) -> FloatArray:
+        """da/dt per unit c on the steps ``days`` (each step's on its own: a forked child may take half)."""
+        return np.array(
+            [
+                a * a / MU_EARTH_M3_S2 * air_drag_rate(scenario, a, e, inclination, day)
+                for a, day in zip(a_path[days], middle[days], strict=True)
+            ],
+            dtype=np.float64,
+        )
+
+    from orbit_env.workers import in_two_processes
+
+    rate = in_two_processes(rates, middle.size, min_size=FIT_FORK_MIN_STEPS)
     # The model's drop of a from the first set to each set per unit c [m per m^2/kg].
     cumulative = np.concatenate([[0.0], np.cumsum(rate * np.diff(grid) * 86400.0)])
     unit_drop = np.interp(t, grid, cumulative)

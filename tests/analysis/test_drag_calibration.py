@@ -96,6 +96,28 @@ def test_a_history_fit_recovers_the_drag_of_a_decay_made_in_the_same_air():
         fit_history(rising, scenario)
 
 
+def test_a_history_fit_is_the_same_with_half_its_steps_in_a_forked_child(request, monkeypatch):
+    # fit_history hands half of its daily steps' air to a forked child (`in_two_processes`): each step is
+    # computed on its own, so the fit is the same bit for bit as in one process. BEESAT-4's last four sets
+    # (44 daily steps, under the record's Sun).
+    from orbit_env import workers
+    from orbit_env.analysis.elements import read_tle
+    from orbit_env.decay.solar_record import load_record
+
+    sets = read_tle(next(DATA.glob("41619_*.tle")))[-4:]
+    scenario = Scenario(MsisAir(load_record(), sets[-1].epoch_days), rotating_atmosphere=True)
+    monkeypatch.setattr(workers, "can_fork", lambda: False)
+    alone = fit_history(sets, scenario)
+    monkeypatch.undo()
+    request.getfixturevalue("forking")
+    forks = []
+    original = workers.Forked.__init__
+    monkeypatch.setattr(workers.Forked, "__init__", lambda self, *a, **k: forks.append(1) or original(self, *a, **k))
+    split = fit_history(sets, scenario)
+    assert forks  # the steps were split
+    assert split == alone
+
+
 def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():
     # A set whose ndot is SGP4's own decay rate of B* gives the same calibrated c from either.
     satrec = satrec_at(400.0, 1e-4)
