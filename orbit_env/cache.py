@@ -186,11 +186,13 @@ def stamp(kind: str, description: str | None) -> tuple[int, int] | None:
     written the table since: a process that merges before it writes (`locked`) need not read it.
     """
     path = None if description is None else _path(kind, description)
+    if path is None:
+        return None
     try:
-        status = None if path is None else path.stat()
+        status = path.stat()
     except OSError:
         return None
-    return None if status is None else (status.st_ino, status.st_mtime_ns)
+    return status.st_ino, status.st_mtime_ns
 
 
 @contextlib.contextmanager

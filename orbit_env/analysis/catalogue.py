@@ -344,7 +344,7 @@ def _from_own_epochs(
     with tqdm(total=int(valid.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
         # Rows with no lifetime to compute go with the first date: their records say why.
         for k, date in enumerate(dates if dates.size else [np.nan]):
-            members = np.flatnonzero((epoch_days == date) | (~valid if k == 0 else False))
+            members = np.flatnonzero((valid & (epoch_days == date)) | (~valid & (k == 0)))
             part, summary = batch_lifetimes(
                 [rows[i] for i in members],
                 *(x[members] for x in inputs),

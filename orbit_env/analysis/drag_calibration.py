@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
+from orbit_env.workers import in_two_processes
 
 FloatArray = NDArray[np.float64]
 
@@ -247,8 +248,6 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
             ],
             dtype=np.float64,
         )
-
-    from orbit_env.workers import in_two_processes
 
     rate = in_two_processes(rates, middle.size, min_size=FIT_FORK_MIN_STEPS)
     # The model's drop of a from the first set to each set per unit c [m per m^2/kg].

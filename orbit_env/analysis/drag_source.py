@@ -15,6 +15,7 @@ The command line (`orbit_env.cli.orbit_inputs`) only reads the flags into
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -262,10 +263,8 @@ def element_set_orbits(
         try:
             fit = None
             if len(history) > 1:
-                try:
+                with contextlib.suppress(NoHistoryToFit):  # else the latest set alone, as for an object of one set
                     fit = fit_history(history, scenario)
-                except NoHistoryToFit:  # the latest set alone, as for an object of one set
-                    fit = None
             if fit is not None:
                 c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
             else:

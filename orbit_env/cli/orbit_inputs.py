@@ -109,7 +109,8 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
 
     Sets ``args.atmosphere`` (msis when there is an epoch and no ``--atmosphere``, else
     paper), ``args.epoch`` (a TLE's, unless given), ``args.inclination`` (a TLE's, else 0)
-    and ``args.height_reference``. A ``--batch`` of element sets without ``--epoch`` sets
+    and ``args.height_reference``. With ``--batch``, ``args.batch_element_sets`` and the sets
+    read (``args.batch_sets``, None for a CSV); a batch of element sets without ``--epoch`` sets
     ``args.rows_own_epochs``: each row's air starts at its object's latest set
     (`orbit_env.analysis.catalogue.batch_lifetimes`'s ``epoch_days``).
     """
@@ -152,10 +153,11 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         from orbit_env.analysis.elements import looks_like_tle, read_tle
 
         args.batch_element_sets = looks_like_tle(args.batch)
+        args.batch_sets = read_tle(args.batch) if args.batch_element_sets else None  # read once (`read_orbits`)
         dated = "epoch" in air_model(args.atmosphere or DATED_AIR).options
         # A batch of element sets: each object from its own latest set's epoch, as --tle starts from its set's.
-        if args.batch_element_sets and args.epoch is None and dated:
-            first = min(read_tle(args.batch), key=lambda s: s.epoch_days)
+        if args.batch_sets is not None and args.epoch is None and dated:
+            first = min(args.batch_sets, key=lambda s: s.epoch_days)
             args.epoch = first.epoch_iso.rstrip("Z")  # dates the air; each row moves it to its own
             args.rows_own_epochs = True
     if args.inclination is None:
@@ -309,12 +311,12 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
     import numpy as np
 
     from orbit_env.analysis.catalogue_io import BatchOrbits, read_batch
-    from orbit_env.analysis.elements import looks_like_tle, read_tle
 
-    if looks_like_tle(args.batch) and not getattr(args, "height_reference_given", False):
+    sets = args.batch_sets  # read by `prepare`; None for a CSV
+    if sets is not None and not getattr(args, "height_reference_given", False):
         args.height_reference = "equatorial"  # element sets give heights above the equatorial radius
     offset_m = offset_km(args.height_reference) * 1e3
-    if not looks_like_tle(args.batch):
+    if sets is None:
         rows, hp, ha, c, inc, status = read_batch(
             args.batch, satellite.drag_coefficient, satellite.drag_parameter_m2_kg, args.inclination
         )
@@ -323,7 +325,7 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
     if args.height_reference != "equatorial":
         raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
     return element_set_orbits(
-        read_tle(args.batch),
+        sets,
         satellite,
         scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0)),
         satellite_given=satellite_inputs(args).given,

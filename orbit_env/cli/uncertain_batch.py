@@ -26,8 +26,9 @@ from orbit_env.cache import source_digest
 from orbit_env.checks import check_number
 from orbit_env.cli.orbit_inputs import records_in_reference
 
-#: Options that change no result (where the results go, how they are shown, where they run).
-NOT_IN_FINGERPRINT = frozenset({"out", "force", "no_progress", "workers", "address", "no_cache", "func"})
+#: Options that change no result (where the results go, how they are shown, where they run), and the batch
+#: file's element sets as `orbit_inputs.prepare` read them (the file's bytes are in the fingerprint).
+NOT_IN_FINGERPRINT = frozenset({"out", "force", "no_progress", "workers", "address", "no_cache", "func", "batch_sets"})
 
 
 @dataclass(frozen=True)
