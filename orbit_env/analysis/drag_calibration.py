@@ -25,6 +25,7 @@ Units: SI (m, kg, s), km only where named.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -32,6 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env import cache
 from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
 from orbit_env.workers import in_two_processes
 
@@ -199,6 +201,15 @@ class DragFit:
         }
 
 
+def _rates_description(
+    air: str, scenario: Any, a_path: FloatArray, middle: FloatArray, eccentricity: float, inclination_deg: float
+) -> str:
+    """The cache description of a history fit's rates: the air's, the scale, the turning air and the orbit's path."""
+    path = hashlib.sha256(np.concatenate([a_path, middle]).tobytes()).hexdigest()
+    settings = (scenario.density_scale, bool(scenario.corotating), eccentricity, inclination_deg, FIT_SPAN_DAYS)
+    return f"history rates {air} {cache.describe(tuple(float(v) for v in settings))} path={path}"
+
+
 class NoHistoryToFit(ValueError):
     """A history with fewer than two sets a day apart within `HISTORY_SPAN_DAYS` of its latest: nothing to fit.
 
@@ -249,7 +260,16 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
             dtype=np.float64,
         )
 
-    rate = in_two_processes(rates, middle.size, min_size=FIT_FORK_MIN_STEPS)
+    # The steps' air is most of a fit's cost: kept on disk, so that the same history (another command on
+    # the same file, a batch run again) is fitted without NRLMSIS. The key holds all that the rates read.
+    air = scenario.air.near_description(middle, FIT_SPAN_DAYS)
+    key = None if air is None else _rates_description(air, scenario, a_path, middle, e, inclination)
+    stored = cache.load("fit", key)
+    if stored is not None:
+        rate = stored["rate"]
+    else:
+        rate = in_two_processes(rates, middle.size, min_size=FIT_FORK_MIN_STEPS)
+        cache.store("fit", key, {"rate": rate})
     # The model's drop of a from the first set to each set per unit c [m per m^2/kg].
     cumulative = np.concatenate([[0.0], np.cumsum(rate * np.diff(grid) * 86400.0)])
     unit_drop = np.interp(t, grid, cumulative)

@@ -99,16 +99,18 @@ def test_a_history_fit_recovers_the_drag_of_a_decay_made_in_the_same_air():
 def test_a_history_fit_is_the_same_with_half_its_steps_in_a_forked_child(request, monkeypatch):
     # fit_history hands half of its daily steps' air to a forked child (`in_two_processes`): each step is
     # computed on its own, so the fit is the same bit for bit as in one process. BEESAT-4's last four sets
-    # (44 daily steps, under the record's Sun).
+    # (45 daily steps, under the record's Sun).
     from orbit_env import workers
     from orbit_env.analysis.elements import read_tle
     from orbit_env.decay.solar_record import load_record
 
     sets = read_tle(next(DATA.glob("41619_*.tle")))[-4:]
     scenario = Scenario(MsisAir(load_record(), sets[-1].epoch_days), rotating_atmosphere=True)
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", "off")  # else the second fit reads the first's air from disk
     monkeypatch.setattr(workers, "can_fork", lambda: False)
     alone = fit_history(sets, scenario)
     monkeypatch.undo()
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", "off")
     request.getfixturevalue("forking")
     forks = []
     original = workers.Forked.__init__
@@ -116,6 +118,34 @@ def test_a_history_fit_is_the_same_with_half_its_steps_in_a_forked_child(request
     split = fit_history(sets, scenario)
     assert forks  # the steps were split
     assert split == alone
+
+
+def test_a_history_fits_air_is_kept_on_disk_under_a_key_of_all_it_reads(monkeypatch, tmp_path):
+    # A fit's daily air (NRLMSIS over the orbit, about 30 ms a step) is kept in the disk cache: the same
+    # sets in the same air are fitted again without NRLMSIS, to the same bit; a scale, another Sun or
+    # other sets are another key (each computed afresh, and the scale's fit exactly what it must be).
+    from orbit_env import workers
+    from orbit_env.analysis.elements import read_tle
+    from orbit_env.decay.solar_record import load_record
+
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(workers, "can_fork", lambda: False)  # every step's air in this process, counted
+    calls = []
+    original = MsisAir.density_near_kg_m3
+    monkeypatch.setattr(MsisAir, "density_near_kg_m3", lambda *a, **k: calls.append(1) or original(*a, **k))
+    sets = read_tle(next(DATA.glob("41619_*.tle")))[-4:]
+    scenario = Scenario(MsisAir(load_record(), sets[-1].epoch_days), rotating_atmosphere=True)
+    first = fit_history(sets, scenario)
+    steps = len(calls)
+    assert steps == 45 and len(list(tmp_path.glob("fit-*.npz"))) == 1  # 45 daily steps over 44.2 days
+    assert fit_history(sets, scenario) == first and len(calls) == steps  # read back, no NRLMSIS
+    scaled = fit_history(sets, Scenario(scenario.air, density_scale=2.0, rotating_atmosphere=True))
+    assert len(calls) == 2 * steps
+    assert scaled.drag_parameter_m2_kg == pytest.approx(first.drag_parameter_m2_kg / 2.0, rel=1e-12)
+    quiet = MsisAir(ConstantActivity(70.0, 70.0, 4.0), sets[-1].epoch_days)
+    assert fit_history(sets, Scenario(quiet, rotating_atmosphere=True)) != first and len(calls) == 3 * steps
+    fit_history(sets[1:], scenario)
+    assert len(calls) > 3 * steps and len(list(tmp_path.glob("fit-*.npz"))) == 4
 
 
 def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():

@@ -198,6 +198,24 @@ class MsisAir(Air):
             version=self.version,
         )
 
+    def near_description(self, epochs_days: Any, span_days: int) -> str | None:
+        """Dated: the version, the node's local time and a digest of the indices and days of the year NRLMSIS reads.
+
+        The indices themselves, not the activity's name: an imported record describes itself by its numbers.
+        """
+        if not self.dated:
+            return None
+        import hashlib
+
+        import numpy as np
+
+        from orbit_env.decay.solar import day_of_year
+
+        days = np.asarray(epochs_days, dtype=np.float64)[:, None] - np.arange(span_days)[::-1]
+        read = np.stack([*self.solar.indices(days), day_of_year(days)])
+        digest = hashlib.sha256(np.ascontiguousarray(read, dtype=np.float64).tobytes()).hexdigest()
+        return f"MsisAir dated version={self.version!r} node={self.ascending_node_local_time_h!r} days={digest}"
+
     def mean_density_over_inclinations_kg_m3(self, altitude_m: Any, inclinations_deg: Any, **nodes: Any) -> Any:
         """`orbit_env.physics.atmosphere.msis.mean_density_over_inclinations_kg_m3` of constant activity."""
         from orbit_env.physics.atmosphere.msis import mean_density_over_inclinations_kg_m3
