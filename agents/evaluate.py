@@ -301,6 +301,11 @@ class ActingOnly:
         """Nothing to clear."""
 
 
+def _no_schedule(_progress: float) -> float:
+    """A training schedule's stand-in in a model loaded to act (`load_model`)."""
+    return 0.0
+
+
 def load_model(
     env_id: str, model_path: str | Path | None = None, warn: Callable[[str], None] | None = None
 ) -> tuple[str, Predictor] | None:
@@ -342,10 +347,15 @@ def load_model(
     from stable_baselines3.common.save_util import load_from_zip_file
 
     torch.set_num_threads(1)
+    # What only training reads (schedules saved as closures, which another cloudpickle cannot rebuild: SB3 warned
+    # "Could not deserialize object learning_rate" on every evaluation) is replaced, not unpickled.
+    training_only = {"learning_rate": 0.0, "lr_schedule": _no_schedule, "clip_range": _no_schedule}
     try:
-        data, _, _ = load_from_zip_file(path, device="cpu")
+        data, _, _ = load_from_zip_file(path, device="cpu", custom_objects=training_only)
         kwargs = {**(data or {}).get("policy_kwargs", {}), "optimizer_class": ActingOnly}
-        model = _algorithm_class(algorithm).load(path, device="cpu", custom_objects={"policy_kwargs": kwargs})
+        model = _algorithm_class(algorithm).load(
+            path, device="cpu", custom_objects={**training_only, "policy_kwargs": kwargs}
+        )
     except Exception as error:  # a damaged file fails in many ways: one line names it
         raise ValueError(
             f"{path} does not load as a {algorithm.upper()} model: {type(error).__name__}: {error}"
@@ -392,7 +402,7 @@ def all_policies(
     policies = hand_coded_policies(env_id)
     if include_dp:
         if progress is not None:
-            progress("dp (solving)")
+            progress("dp (solved on the first run, then read from the disk cache)")
         policies["dp"] = dp_policy(env_id, dp_lookahead, dp_rollout)
     if learned is not None:
         policies[learned[0]] = learned[1]

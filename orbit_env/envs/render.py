@@ -166,13 +166,13 @@ class TrackRenderer:
         (self._now,) = axes.plot([], [], "o", color="tab:blue")
         self._title = axes.set_title(" ", fontsize=9)
         self._axes = axes
-        # rgb_array frames are blitted: the background (the curves, the axes) is drawn once per x range and
-        # kept as pixels; a frame restores it and draws only what changes (85 ms a frame -> a few ms).
+        # rgb_array frames are blitted: the background (the curves, the axes) is drawn once per pair of axis
+        # ranges and kept as pixels; a frame restores it and draws only what changes (85 ms a frame -> a few ms).
         self._moving = (self._track, self._burns, self._now, self._title)
         for artist in self._moving:
             artist.set_animated(not human)
         self._background: Any = None
-        self._background_xlim: tuple[float, float] | None = None
+        self._background_limits: tuple[tuple[float, float], tuple[float, float]] | None = None
 
     def draw(
         self, track: list[tuple[float, float, float]], *, time_days: float, dv_left_m_s: float
@@ -185,17 +185,18 @@ class TrackRenderer:
         self._now.set_data(points[-1:, 0], points[-1:, 1])
         segments = [points[k - 1 : k + 1] for k in range(1, len(track)) if track[k][2] > 0.0]
         self._burns.set_segments(segments)
-        if points.size:
+        if points.size:  # the paper's frame, widened to hold the track (the solar task flies perigees to 580 km)
             self._axes.set_xlim(REENTRY_ALTITUDE_M / 1e3, max(1700.0, 1.05 * points[:, 0].max()))
+            self._axes.set_ylim(REENTRY_ALTITUDE_M / 1e3, max(550.0, 1.05 * points[:, 1].max()))
         self._title.set_text(f"t = {time_days:.1f} d, delta-v left {dv_left_m_s:.0f} m/s")
         if self.human:
             self._plt.pause(1.0 / self.fps)
             return None
         canvas = self.figure.canvas
-        xlim = self._axes.get_xlim()
-        if self._background is None or xlim != self._background_xlim:
+        limits = (self._axes.get_xlim(), self._axes.get_ylim())
+        if self._background is None or limits != self._background_limits:
             canvas.draw()  # everything but the animated artists
-            self._background, self._background_xlim = canvas.copy_from_bbox(self.figure.bbox), xlim
+            self._background, self._background_limits = canvas.copy_from_bbox(self.figure.bbox), limits
         else:
             canvas.restore_region(self._background)
         for artist in self._moving:

@@ -41,9 +41,11 @@ class SB3VecEnv(VecEnv):
     Finished episodes follow SB3's convention: the returned observation starts the
     next episode, ``infos[i]["terminal_observation"]`` is the last one of the
     finished episode and ``infos[i]["TimeLimit.truncated"]`` tells truncation from
-    termination (for value bootstrapping), and ``reentered``, ``days_in_orbit`` and
-    ``dv_used_m_s`` its outcome (see `OrbitRaisingEnv`; only at the episode's end, so
-    that a step builds no dicts for the others). Attributes and methods act on the whole
+    termination (for value bootstrapping), and the finished episode's ``final_info`` as the
+    single environment's info: ``reentered``, ``days_in_orbit``, ``dv_used_m_s`` (see
+    `OrbitRaisingEnv`), and for the solar task ``date`` and, at the mission's end,
+    ``disposal_dv_m_s`` and ``complies`` (only at the episode's end, so that a step builds no
+    dicts for the others). Attributes and methods act on the whole
     batch, so ``get_attr`` returns the batch's value once per index.
 
     Seeding: ``seed(s)`` then ``reset()`` seeds the batch's one generator with
@@ -96,11 +98,12 @@ class SB3VecEnv(VecEnv):
         infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         if dones.any():
             final_obs, final_info = info["final_obs"], info["final_info"]
+            keys = [key for key in final_info if not key.startswith("_") and f"_{key}" in final_info]
             for i in np.flatnonzero(dones):
                 infos[i]["terminal_observation"] = final_obs[i]
                 infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
-                for key in OUTCOME_KEYS:  # the finished episode's outcome, e.g. for VecMonitor's info_keywords
-                    if key in final_info:
+                for key in keys:  # the finished episode's outcome, e.g. for VecMonitor's info_keywords
+                    if final_info[f"_{key}"][i]:
                         infos[i][key] = final_info[key][i].item()
         return obs, rewards.astype(np.float32), dones, infos
 

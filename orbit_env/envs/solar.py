@@ -113,12 +113,16 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     ``solar_split`` ("train" or "test"), ``disposal_years`` (0.5-25), ``block_days``,
     ``inclination_deg``, ``start_span_km``, and any field of `OrbitRaisingConfig` (the satellite,
     the burn sizes, ``horizon_steps``, ``propellant_cost_per_m_s``, ``start_perigee_km``).
+    ``render_mode``: "rgb_array" and "human" draw the (apogee, perigee) plane with the track, a
+    month with a burn in red, over the paper's curves as the other environments draw them (needs
+    ``orbit-env[plot]``; Stable-Baselines3's ``make_vec_env`` asks for "rgb_array"); "ansi" returns
+    one line of text.
 
     ## Version History
     * v0: initial version (2026-12-04).
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["ansi"], "render_fps": 4}
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 4}
     _spec: EnvSpec | None = None
 
     def __init__(
@@ -139,6 +143,17 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._state: BatchState | None = None
         self._dv_used_m_s = 0.0
         self._last: dict[str, Any] = {}
+        # Pictures ("human", "rgb_array"): the (apogee, perigee) plane with the track, as the known-density envs
+        # draw it (`orbit_env.envs.render.TrackRenderer`); (perigee [m], apogee [m], the month's burn [m/s]).
+        self._drawn = render_mode in ("human", "rgb_array")
+        self._track: list[tuple[float, float, float]] = []
+        self._renderer: Any = None
+
+    # A pickled env carries no figure: it is drawn again on the next render().
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_renderer"] = None
+        return state
 
     @property
     def spec(self) -> EnvSpec | None:
@@ -171,6 +186,10 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._state = solar_task.start(self.task, self.np_random, 1, options)
         self._start = solar_task.start_options(self._state)
         self._dv_used_m_s = 0.0
+        if self._drawn:
+            self._track = [(float(self._state.perigee_m[0]), float(self._state.apogee_m[0]), 0.0)]
+            if self.render_mode == "human":
+                self.render()
         return solar_task.observe(self.task, self._state)[0], self._outcome()
 
     def step(self, action: Any) -> tuple[NDArray[np.float32], float, bool, bool, dict[str, Any]]:
@@ -189,6 +208,10 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._dv_used_m_s += disposal
             info["dv_used_m_s"] = self._dv_used_m_s
         self._last = info
+        if self._drawn:
+            self._track.append((float(state.perigee_m[0]), float(state.apogee_m[0]), burn))
+            if self.render_mode == "human":
+                self.render()
         return obs, reward, terminated, truncated, info
 
     def _outcome(self) -> dict[str, Any]:
@@ -201,12 +224,23 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             "date": solar_task.date_of(self.task, float(today)),
         }
 
-    def render(self) -> str | None:
-        """One text line: the date, the orbit, the tank and the last burn (``render_mode="ansi"``)."""
+    def render(self) -> Any:
+        """The (apogee, perigee) plane with the track ("rgb_array", "human"), or one text line ("ansi").
+
+        The text: the date, the orbit, the tank and the last burn.
+        """
         if self.render_mode is None:
-            gym.logger.warn("render() called without a render_mode; pass render_mode='ansi' to gymnasium.make")
+            gym.logger.warn("render() called without a render_mode; pass render_mode to gymnasium.make")
             return None
         state = self.task_state
+        if self._drawn:
+            from orbit_env.envs.render import TrackRenderer
+
+            if self._renderer is None:
+                self._renderer = TrackRenderer(human=self.render_mode == "human", fps=self.metadata["render_fps"])
+            return self._renderer.draw(
+                self._track, time_days=float(state.time_days[0]), dv_left_m_s=float(state.dv_left_m_s[0])
+            )
         info = self._last
         return (
             f"{solar_task.date_of(self.task, float(solar_task.today(self.task, state)[0]))}  "
@@ -214,6 +248,12 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             f"apogee {state.apogee_m[0] / 1e3:7.1f} km  dv left {state.dv_left_m_s[0]:6.1f} m/s  "
             f"burn {info.get('burn_m_s', 0.0):4.1f} m/s"
         )
+
+    def close(self) -> None:
+        """Close the render window, if any."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
 
 
 class OrbitRaisingSolarVectorEnv(VectorEnv):
@@ -310,10 +350,16 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         if self.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP:
             done = np.flatnonzero(ends)
             if done.size:
-                final_obs = obs.copy()
-                final_info = dict(info)
+                # As SyncVectorEnv: final_obs an object array (the finished rows' observations, None elsewhere);
+                # the finished episodes' info moves to final_info, and the new episodes' info has none of the
+                # step's keys (their masks False there) and their outcome so far (nothing yet).
+                final_obs = np.empty(n, dtype=object)
+                final_obs[done] = np.fromiter(obs[done], dtype=object, count=done.size)
+                final_info = {key: value & ends if key.startswith("_") else value.copy() for key, value in info.items()}
                 obs[done] = self._restart(done)
                 info = {**info, **self._outcome(np.ones(n, dtype=bool))}
+                for key in ("burn_m_s", *SOLAR_END_KEYS):
+                    info[f"_{key}"] = info[f"_{key}"] & ~ends
                 info["final_obs"], info["_final_obs"] = final_obs, ends.copy()
                 info["final_info"], info["_final_info"] = final_info, ends.copy()
         else:

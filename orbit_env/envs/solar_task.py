@@ -289,6 +289,13 @@ def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping
     state.start_day = day
     update_satellite(task, state)
     if "curve_label" in options or "curve_tau" in options:
+        if not ("curve_label" in options and "curve_tau" in options):
+            given = "curve_label" if "curve_label" in options else "curve_tau"
+            raise ValueError(f"reset option {given} needs ['curve_label', 'curve_tau'] together")
+        if "perigee_km" in options or "apogee_km" in options:
+            raise ValueError(
+                "reset options ['curve_label', 'curve_tau'] and ['perigee_km', 'apogee_km'] both pin the orbit"
+            )
         label = np.broadcast_to(np.asarray(options["curve_label"], dtype=np.float64), (size,))
         tau = np.broadcast_to(np.asarray(options["curve_tau"], dtype=np.float64), (size,))
         hp, ha, period = task.curves.at(label, tau)

@@ -109,6 +109,23 @@ def test_apogee_threshold_burns_only_below_threshold():
     assert burns[0] == 100.0 and burns[1] == 0.0
 
 
+@pytest.mark.parametrize("env_id", sorted(evaluate_module.SHIPPED_MODELS))
+def test_the_shipped_models_load_to_act_without_unpickling_their_schedules(env_id):
+    # The schedules are closures that another cloudpickle cannot rebuild: SB3 warned "Could not deserialize
+    # object learning_rate" on every evaluation. Acting needs none of them, so load_model replaces them.
+    import warnings
+
+    from orbit_env.agents.evaluate import load_model
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        name, model = load_model(env_id)
+    messages = [str(w.message) for w in caught]
+    assert name == "ppo" and not [m for m in messages if "deserialize" in m], messages
+    obs, _ = gymnasium.make(env_id).reset(seed=0)
+    assert gymnasium.make(env_id).action_space.contains(model.predict(obs, deterministic=True)[0])
+
+
 def test_the_shipped_ppo_beats_the_greedy_look_ahead_on_validation_episodes():
     # Issue 4: PPO must beat every hand-coded policy; greedy is the best of them. Measured on
     # 1000 validation episodes (seed 777, neither training's 0 nor evaluation's 12345):

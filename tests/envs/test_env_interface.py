@@ -8,6 +8,7 @@ without a display, outcome keys in ``info``).
 from __future__ import annotations
 
 import copy
+import pickle
 from typing import Any
 
 import gymnasium as gym
@@ -15,7 +16,7 @@ import numpy as np
 import pytest
 from gymnasium.wrappers import TimeLimit
 
-from orbit_env.envs import ENV_IDS, register_envs
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID, register_envs
 from orbit_env.envs.config import DEFAULT_HORIZON_STEPS
 
 if not all(env_id in gym.envs.registry for env_id in ENV_IDS):
@@ -206,6 +207,39 @@ def test_sb3_infos_hold_each_finished_episodes_outcome():
         assert all(set(OUTCOME).isdisjoint(infos[i]) for i in np.flatnonzero(~dones))
     assert finished[0]["reentered"] is True and 0.0 < finished[0]["days_in_orbit"] < 40.0
     assert finished[1]["reentered"] is False and finished[1]["dv_used_m_s"] == 0.0
+
+
+def test_sb3_infos_hold_the_solar_missions_end():
+    # The solar task's end: its date, the disposal burn and the verdict reach SB3's infos too.
+    pytest.importorskip("stable_baselines3")
+    from orbit_env.envs.sb3 import make_sb3_vec_env
+
+    venv = make_sb3_vec_env(SOLAR_ENV_ID, num_envs=2, seed=0, horizon_steps=3)
+    venv.reset()
+    for _ in range(3):
+        _, _, dones, infos = venv.step(np.zeros(2, dtype=np.int64))
+    assert dones.all()
+    for info in infos:
+        assert {"complies", "disposal_dv_m_s", "date", "reentered", "episode"} <= set(info), info
+        assert info["complies"] is True and info["disposal_dv_m_s"] >= 0.0 and info["episode"]["l"] == 3
+
+
+@pytest.mark.parametrize("env_id", [*ENV_IDS, SOLAR_ENV_ID])
+def test_sb3s_own_make_vec_env_makes_every_id(env_id):
+    # Stable-Baselines3's make_vec_env asks gymnasium.make for render_mode="rgb_array" (retrying without it
+    # only on a TypeError): every id must draw frames, the solar task's too (it refused them before).
+    pytest.importorskip("stable_baselines3")
+    pytest.importorskip("matplotlib")
+    from stable_baselines3.common.env_util import make_vec_env
+
+    venv = make_vec_env(env_id, n_envs=2, seed=0)
+    assert venv.reset().shape == (2, *venv.observation_space.shape)
+    venv.step(np.zeros((2, *venv.action_space.shape), dtype=venv.action_space.dtype))
+    frame = venv.envs[0].render()
+    assert frame.shape == (480, 640, 3) and frame.dtype == np.uint8 and frame.std() > 0.0
+    again = pickle.loads(pickle.dumps(venv.envs[0].unwrapped))  # the figure stays behind, drawn anew
+    assert again.render().shape == (480, 640, 3)
+    venv.close()
 
 
 # --------------------------------------------------------------------------------------

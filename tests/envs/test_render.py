@@ -84,10 +84,12 @@ def test_rgb_array_frames_are_blitted_and_equal_a_full_redraw():
 
     # Frames restore the background's pixels and draw only the track, the burns, the current point and
     # the title; each must be the very image a full redraw gives (also after the x range grows past
-    # 1700 km, which redraws the background).
+    # 1700 km, or the y range past 550 km, as the solar task's perigees need: each redraws the background).
     renderer = TrackRenderer(human=False, fps=8.0)
-    track = [(300e3 + k * 1e3, 800e3 + k * 40e3, 1.0 if k % 3 == 0 else 0.0) for k in range(30)]
-    for k in (1, 5, 20, 30):  # apogee up to 1960 km from k = 24 on
+    wide = [(300e3 + k * 1e3, 800e3 + k * 40e3, 1.0 if k % 3 == 0 else 0.0) for k in range(30)]
+    high = [(450e3 + k * 5e3, 600e3 + k * 10e3, 1.0 if k % 3 == 0 else 0.0) for k in range(30)]
+    # apogee up to 1960 km from k = 24 on; perigee up to 595 km from k = 20 on
+    for track, k in [(wide, 1), (wide, 5), (wide, 20), (wide, 30), (high, 10), (high, 20), (high, 30)]:
         frame = renderer.draw(track[:k], time_days=float(k), dv_left_m_s=100.0 - k)
         for artist in renderer._moving:
             artist.set_animated(False)

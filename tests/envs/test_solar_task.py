@@ -297,6 +297,63 @@ def test_the_vector_env_restarts_on_the_next_step() -> None:
     assert (info["dv_used_m_s"] == 0.0).all() and (info["days_in_orbit"] == 0.0).all()
 
 
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        ({"curve_label": 1.0}, r"reset option curve_label needs \['curve_label', 'curve_tau'\] together"),
+        ({"curve_tau": 1.0}, r"reset option curve_tau needs \['curve_label', 'curve_tau'\] together"),
+        ({"curve_label": -5.0, "curve_tau": 5.0, "perigee_km": 400.0}, r"both pin the orbit"),
+    ],
+)
+def test_half_a_curve_point_is_refused_naming_what_is_missing(options, named) -> None:
+    # It was a bare KeyError: 'curve_tau'.
+    with pytest.raises(ValueError, match=named):
+        gym.make(SOLAR_ENV_ID).reset(seed=0, options=options)
+
+
+def test_the_vector_envs_same_step_autoreset_is_gymnasiums_sync_vector_envs() -> None:
+    # SAME_STEP as Gymnasium's SyncVectorEnv of single environments gives it: final_obs an object array
+    # (None where no episode ended), the finished episodes' info (the rule's keys where it was judged) in
+    # final_info, and the new episodes' info without the step's keys. Pinned starts (two re-enter early,
+    # two live to the rule), so that both step the same missions up to and through the first ends.
+    n = 4
+    options = {"start_date": "2003-06-01", "perigee_km": 360.0, "apogee_km": 370.0}
+    vec = gym.make_vec(SOLAR_ENV_ID, num_envs=n, vectorization_mode="vector_entry_point", autoreset_mode="SameStep")
+    sync = gym.vector.SyncVectorEnv([lambda: gym.make(SOLAR_ENV_ID) for _ in range(n)], autoreset_mode="SameStep")
+    obs_v, _ = vec.reset(seed=0, options=options)
+    obs_s, _ = sync.reset(seed=0, options=options)
+    np.testing.assert_array_equal(obs_v, obs_s)
+    actions = np.array([0, 0, 3, 3])  # coast and re-enter; the largest burn each month until the tank is empty
+    ends, same = set(), np.ones(n, dtype=bool)  # rows on the same mission in both (a restart draws its own)
+    for _ in range(61):
+        obs_v, reward_v, terminated_v, truncated_v, info_v = vec.step(actions)
+        obs_s, reward_s, terminated_s, truncated_s, info_s = sync.step(actions)
+        done = (terminated_s | truncated_s) & same
+        np.testing.assert_array_equal(terminated_v[same], terminated_s[same])
+        np.testing.assert_array_equal(truncated_v[same], truncated_s[same])
+        np.testing.assert_allclose(reward_v[same], reward_s[same], rtol=1e-9)
+        np.testing.assert_array_equal(obs_v[same & ~done], obs_s[same & ~done])
+        if not done.any():
+            continue
+        ends.update("terminated" if terminated_s[i] else "truncated" for i in np.flatnonzero(done))
+        final_v, final_s = info_v["final_obs"], info_s["final_obs"]
+        assert final_v.dtype == object and final_v.shape == final_s.shape == (n,)
+        for i in range(n):
+            assert (final_v[i] is None) == (final_s[i] is None) == (not done[i])
+            if done[i]:
+                np.testing.assert_array_equal(final_v[i], final_s[i])
+        for key in ("reentered", "days_in_orbit", "dv_used_m_s", "disposal_dv_m_s", "complies", "burn_m_s"):
+            for which_v, which_s in ((info_v["final_info"], info_s["final_info"]), (info_v, info_s)):
+                mask = which_s.get(f"_{key}", np.zeros(n, dtype=bool))
+                np.testing.assert_array_equal(which_v[f"_{key}"][same], mask[same], err_msg=key)
+                if (mask & same).any():
+                    np.testing.assert_array_equal(which_v[key][mask & same], which_s[key][mask & same], err_msg=key)
+        same &= ~done
+        if ends == {"terminated", "truncated"}:
+            break
+    assert ends == {"terminated", "truncated"}, "the test must see both ways a mission ends"
+
+
 def test_the_optimum_beats_every_rule_on_its_mission() -> None:
     task = TEST_TASK
     options = starts(task, 1, 2024)
