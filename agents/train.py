@@ -45,12 +45,14 @@ class TrainResult:
     best_model_path: Path | None = None  #: the evaluation callback's best model, if it ran
 
 
-class MissionEndIsTerminal(VecEnvWrapper):
-    """Treat the horizon as the end of the task: no value bootstrapped past it.
+class BootstrapAtHorizon(VecEnvWrapper):
+    """Mark the missions that reach the horizon as truncated, so that SB3 bootstraps the value past it.
 
-    The environments reward days *within* the mission and show the mission clock,
-    so the state at the horizon is terminal for the task; SB3 would otherwise add
-    the value of the life after the mission (Pardo et al. 2018, time limits in RL).
+    The environments end a mission terminated at re-entry and at the horizon alike (`orbit_env.envs`:
+    the reward counts days within the mission and the clock is observed, Pardo et al. 2018, time limits
+    in RL). ``bootstrap_at_horizon = true`` asks SB3 to add the value of the life after the mission
+    anyway: SB3 reads ``infos[i]["TimeLimit.truncated"]``, set here where an episode ended without
+    re-entering.
     """
 
     def reset(self) -> Any:
@@ -58,10 +60,10 @@ class MissionEndIsTerminal(VecEnvWrapper):
         return self.venv.reset()
 
     def step_wait(self) -> Any:
-        """Step, and drop SB3's truncation marks so that the horizon counts as terminal."""
+        """Step, and mark each episode that ended in orbit (at the horizon) as truncated."""
         obs, rewards, dones, infos = self.venv.step_wait()
-        for info in infos:
-            info.pop("TimeLimit.truncated", None)
+        for i in np.flatnonzero(dones):
+            infos[i]["TimeLimit.truncated"] = not infos[i]["reentered"]
         return obs, rewards, dones, infos
 
 
@@ -357,8 +359,8 @@ class BestModelCallback(BaseCallback):
 def training_env(config: dict[str, Any]) -> Any:
     """The SB3 ``VecEnv`` a checked training config trains on, without reward normalization.
 
-    `orbit_env.envs.sb3.make_sb3_vec_env` unmonitored, then `MissionEndIsTerminal`
-    (``bootstrap_at_horizon = false``), the reward shaping, and one ``VecMonitor``
+    `orbit_env.envs.sb3.make_sb3_vec_env` unmonitored, then `BootstrapAtHorizon`
+    (``bootstrap_at_horizon = true``), the reward shaping, and one ``VecMonitor``
     above them all, which sees the episodes PPO is trained on (with shaping, each
     episode's ``mission_return`` beside, for `ReturnsCallback`).
     """
@@ -370,8 +372,8 @@ def training_env(config: dict[str, Any]) -> Any:
     venv: Any = make_sb3_vec_env(
         config["env_id"], num_envs=int(config["num_envs"]), seed=seed, monitor=False, **config["env"]
     )
-    if not config["bootstrap_at_horizon"]:
-        venv = MissionEndIsTerminal(venv)
+    if config["bootstrap_at_horizon"]:
+        venv = BootstrapAtHorizon(venv)
     if config["shaping"] == "never_burn_value":
         from orbit_env.agents.shaping import never_burn_value_shaping
 

@@ -1,5 +1,6 @@
 """README's examples run: its Python examples as doctests, its fast console examples as printed;
-so do the console blocks of the lifetime how-to (docs/how-to/lifetime.md), step by step.
+so do the console blocks of the lifetime how-to (docs/how-to/lifetime.md), step by step, and the
+Python of the getting-started page.
 
 README states what the package prints; these tests hold it to that, so a changed number
 in the code or in README fails here. Python examples print rounded numbers; console
@@ -25,6 +26,7 @@ from orbit_env.cli import main
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text()
 HOWTO = (ROOT / "docs" / "how-to" / "lifetime.md").read_text()
+GETTING_STARTED = (ROOT / "docs" / "getting-started.md").read_text()
 #: Console commands README shows but these tests do not run, and why.
 SLOW = {
     "orbit-env evaluate": "solves the DP optimum on a cold cache (tens of s); tests/agents/test_agents.py runs it",
@@ -96,6 +98,16 @@ def test_readme_python_examples(block):
     out = io.StringIO()
     runner.run(test, out=out.write)
     assert runner.failures == 0, out.getvalue()
+
+
+def test_getting_started_python_examples():
+    # The page's Python blocks build on one another: one doctest, in order.
+    text = "\n".join(blocks(GETTING_STARTED, "python"))
+    test = doctest.DocTestParser().get_doctest(text, {}, "getting-started.md", "getting-started.md", 0)
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
+    out = io.StringIO()
+    runner.run(test, out=out.write)
+    assert runner.tries >= 10 and runner.failures == 0, out.getvalue()
 
 
 @pytest.mark.parametrize(("command", "expected"), list(console_examples()))

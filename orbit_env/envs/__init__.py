@@ -11,6 +11,14 @@ Each has a single environment (``gymnasium.make``) and a numpy-batched vector
 environment (``gymnasium.make_vec(id, num_envs=N)``, autoreset ``NEXT_STEP`` by default);
 `orbit_env.envs.sb3` hands the latter to Stable-Baselines3. The user's manual
 is the docstring of `OrbitRaisingEnv` (of `OrbitRaisingSolarEnv` for the solar task).
+
+**The mission's end is terminal.** An episode ends with ``terminated=True`` at re-entry and at
+the mission's last step alike, and ``truncated`` is never set: the mission's length is part of
+the task (the reward counts days within it, the solar task charges its disposal there, and the
+observation holds the clock), not a time limit outside it, so an agent must not add the value
+of a state after it (Pardo et al. 2018, "Time limits in reinforcement learning", ICML;
+Gymnasium's ``TimeLimit``: truncation is for limits outside the MDP). ``info["reentered"]``
+tells the two ends apart.
 """
 
 from __future__ import annotations
@@ -52,9 +60,9 @@ ENV_IDS = tuple(_VARIANTS)
 def register_envs() -> None:
     """Register the orbit-raising environments with Gymnasium (safe to call twice).
 
-    No ``max_episode_steps``: both environments truncate themselves after
+    No ``max_episode_steps``: the environments end their missions themselves after
     ``horizon_steps`` (a flat keyword of ``gymnasium.make``), the one owner of the
-    truncation and of the observed clock.
+    mission's length and of the observed clock.
     """
     import gymnasium
 

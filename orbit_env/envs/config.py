@@ -30,7 +30,7 @@ from orbit_env.physics.satellite_bounds import (
 #: Largest delta-v a satellite may carry [m/s]. More is beyond escape from low orbit,
 #: never an orbit-raising budget; the bound keeps the observation space bounded.
 MAX_DV_CAPACITY_M_S = 3000.0
-#: Default mission length in steps (``OrbitRaisingConfig.horizon_steps``): the truncation and the clock.
+#: Default mission length in steps (``OrbitRaisingConfig.horizon_steps``): the mission's end and the clock.
 DEFAULT_HORIZON_STEPS = 365
 
 
@@ -111,7 +111,7 @@ class OrbitRaisingConfig:
         max_burn_m_s: Delta-v of the continuous action at +1 [m/s] (100).
         revolutions_per_step: K, revolutions coasted per step (16: about one day).
         horizon_steps: Mission length in steps (365: about a year). It alone sets
-            the truncation and the observation's mission clock.
+            the mission's end and the observation's mission clock.
         propellant_cost_per_m_s: Reward cost of a burn [days per m/s] (0.4: the
             whole tank is worth 120 days of mission, so burning without need costs,
             and a burn that saves a mission pays many times over).

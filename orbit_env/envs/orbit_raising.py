@@ -104,15 +104,19 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     ## Episode End
 
-    Termination: re-entry, perigee at 100 km (the paper's end of integration).
-    Truncation: after ``horizon_steps`` steps (365), by the environment itself:
-    ``horizon_steps`` alone sets the truncation and the mission clock, so the ids
+    Terminated (``terminated=True``) at re-entry, perigee at 100 km (the paper's end of
+    integration), and at the mission's end, after ``horizon_steps`` steps (365): the
+    mission's length is part of the task, not a time limit outside it, so ``truncated`` is
+    never set and no value lies past the horizon (`orbit_env.envs`, "The mission's end is
+    terminal"); ``info["reentered"]`` tells the two apart. The environment ends the mission
+    itself: ``horizon_steps`` alone sets the mission's length and clock, so the ids
     are registered without ``max_episode_steps`` and ``gymnasium.make`` adds no
     ``TimeLimit``. ``env.spec.max_episode_steps`` reports the horizon all the same:
     365, or the ``horizon_steps`` given (``gymnasium.make(id, horizon_steps=100)``
     says 100), the length of a mission that does not re-enter. An environment made
     again from its spec (``gymnasium.make(env.spec)``, as ``check_env`` does) gets a
-    ``TimeLimit`` at that same step, which changes nothing. (A different
+    ``TimeLimit`` at that same step, which adds ``truncated=True`` to the step that
+    terminates (Gymnasium's libraries read that as terminated). (A different
     ``max_episode_steps`` given to ``gymnasium.make`` adds Gymnasium's ``TimeLimit``
     outside the environment, which cannot see it, and the spec then reports that
     limit: pass ``horizon_steps`` instead.)
@@ -185,6 +189,9 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
       burn of 1e-9 m/s then changed a year's return by +0.02 to +0.14 day), and
       ``decode`` inverts table B exactly (it was up to 0.1% off in nu). Returns of
       policies that burn differ from those measured before that date.
+    * v0, episode end changed 2026-12-06 (unreleased, so the id stayed): the mission's
+      end is ``terminated``, as re-entry is; it was ``truncated``. Rewards and dynamics
+      are unchanged.
 
     Examples:
         >>> import gymnasium as gym
@@ -242,8 +249,8 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     @spec.setter
     def spec(self, spec: EnvSpec | None) -> None:
-        # gymnasium.make sets a spec without max_episode_steps (no TimeLimit: the env truncates
-        # itself); readers of the spec (wrappers, researchers) still learn the episode's length.
+        # gymnasium.make sets a spec without max_episode_steps (no TimeLimit: the env ends its
+        # missions itself); readers of the spec (wrappers, researchers) still learn the episode's length.
         if spec is not None and spec.max_episode_steps is None:
             spec = dataclasses.replace(spec, max_episode_steps=self.config.horizon_steps)
         self._spec = spec
@@ -326,12 +333,12 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
             self._track.append((state.perigee_m, state.apogee_m, 0.0))
             if self.render_mode == "human":
                 self.render()
-        # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
+        # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
         return (
             task_model.observe(task, state),
             result.reward,
-            bool(result.terminated),
-            bool(result.truncated),
+            bool(result.terminated or result.truncated),
+            False,
             {"burn_m_s": result.burn_m_s, **self._outcome()},
         )
 

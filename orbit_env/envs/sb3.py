@@ -41,7 +41,8 @@ class SB3VecEnv(VecEnv):
     Finished episodes follow SB3's convention: the returned observation starts the
     next episode, ``infos[i]["terminal_observation"]`` is the last one of the
     finished episode and ``infos[i]["TimeLimit.truncated"]`` tells truncation from
-    termination (for value bootstrapping), and the finished episode's ``final_info`` as the
+    termination (for value bootstrapping: False for this package's environments, whose
+    missions end terminated, `orbit_env.envs`), and the finished episode's ``final_info`` as the
     single environment's info: ``reentered``, ``days_in_orbit``, ``dv_used_m_s`` (see
     `OrbitRaisingEnv`), and for the solar task ``date`` and, at the mission's end,
     ``disposal_dv_m_s`` and ``complies`` (only at the episode's end, so that a step builds no

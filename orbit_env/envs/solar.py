@@ -105,7 +105,9 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     gives back the exact start (``curve_label``, ``curve_tau``, ``start_day``).
 
     ## Episode End
-    Terminated at re-entry (perigee 100 km); truncated after 61 steps, with the rule judged.
+    Terminated at re-entry (perigee 100 km) and after 61 steps, with the rule judged: the mission's
+    end is part of the task (its disposal is charged there), so ``truncated`` is never set
+    (`orbit_env.envs`, "The mission's end is terminal"); ``info["reentered"]`` tells the two apart.
     ``info``: ``burn_m_s``, ``reentered``, ``days_in_orbit``, ``dv_used_m_s``, ``date`` (the
     next step's first day, ISO); at the end also ``disposal_dv_m_s`` and ``complies``.
 
@@ -120,6 +122,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     ## Version History
     * v0: initial version (2026-12-04).
+    * v0, episode end changed 2026-12-06 (unreleased, so the id stayed): the mission's end is
+      ``terminated``, as re-entry is; it was ``truncated``. Rewards and dynamics are unchanged.
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 4}
@@ -212,7 +216,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             self._track.append((float(state.perigee_m[0]), float(state.apogee_m[0]), burn))
             if self.render_mode == "human":
                 self.render()
-        return obs, reward, terminated, truncated, info
+        # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
+        return obs, reward, terminated or truncated, False, info
 
     def _outcome(self) -> dict[str, Any]:
         data = self._state.data  # a batch of one: column 0 (read directly, as the step is timed against CartPole's)
@@ -364,7 +369,8 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
                 info["final_info"], info["_final_info"] = final_info, ends.copy()
         else:
             self._needs_reset = ends
-        return obs, reward, terminated, truncated, info
+        # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
+        return obs, reward, ends.copy(), np.zeros(n, dtype=bool), info
 
     def _restart(self, rows: NDArray[np.intp]) -> NDArray[np.float32]:
         fresh = solar_task.start(self.task, self.np_random, rows.size)

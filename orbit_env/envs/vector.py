@@ -2,9 +2,9 @@
 
 The same functions of `orbit_env.envs.task` as the single environment, called
 on a `BatchState` of shape (num_envs,): one call of the
-universal curves moves every satellite. The vector environment owns truncation
-(``horizon_steps``) and restarts finished satellites as Gymnasium 1.x's
-``autoreset_mode`` says:
+universal curves moves every satellite. The vector environment ends missions
+(re-entry, or ``horizon_steps``: both ``terminated``, see `orbit_env.envs`) and restarts
+finished satellites as Gymnasium 1.x's ``autoreset_mode`` says:
 
 * ``AutoresetMode.NEXT_STEP`` (default, as ``SyncVectorEnv`` and ``CartPoleVectorEnv``):
   the step that ends an episode returns its last observation; the next step ignores
@@ -52,9 +52,10 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     environment's keys as arrays of shape (num_envs,), each with its boolean mask
     ``info["_key"]`` as in Gymnasium's vector API: ``burn_m_s`` after a step, and
     ``reentered``, ``days_in_orbit`` and ``dv_used_m_s`` (`OUTCOME_KEYS`, each
-    episode so far) after every step and reset. Truncation after
-    ``config.horizon_steps`` steps. Finished missions restart as ``autoreset_mode``
-    says (see the module; ``metadata["autoreset_mode"]`` tells which).
+    episode so far) after every step and reset. The mission's end, after
+    ``config.horizon_steps`` steps, is terminal (``terminated``), as re-entry is. Finished
+    missions restart as ``autoreset_mode`` says (see the module; ``metadata["autoreset_mode"]``
+    tells which).
 
     ``reset(options=...)`` takes the single environment's options, each a number
     or an array of shape (num_envs,); they pin only that reset, not the automatic
@@ -63,7 +64,8 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
     batch: sub-environment i is not the single environment seeded with seed + i.
 
     Version History: that of `OrbitRaisingEnv` (the same ids and dynamics),
-    including the dynamics change of 2026-12-03 (the burn relocation fix).
+    including the dynamics change of 2026-12-03 (the burn relocation fix) and the
+    mission's end terminated from 2026-12-06.
 
     Args:
         num_envs: Number of satellites.
@@ -71,7 +73,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         continuous: Continuous burn size instead of the discrete burns.
         density: Density knowledge (default: the paper's atmosphere, known).
         max_episode_steps: If given, must equal ``config.horizon_steps``, which
-            alone sets the truncation and the observation's clock.
+            alone sets the mission's length and the observation's clock.
         render_mode: Only None: render a single environment instead.
         autoreset_mode: ``AutoresetMode`` (or its value, e.g. ``"SameStep"``);
             default ``NEXT_STEP``.
@@ -103,7 +105,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         if max_episode_steps is not None and max_episode_steps != self.config.horizon_steps:
             raise ValueError(
                 f"max_episode_steps={max_episode_steps} but horizon_steps={self.config.horizon_steps}; "
-                f"pass horizon_steps={max_episode_steps}: it alone sets the truncation and the clock"
+                f"pass horizon_steps={max_episode_steps}: it alone sets the mission's length and the clock"
             )
         if render_mode is not None:
             raise ValueError(f"render_mode={render_mode!r} is invalid; the vector environment does not render")
@@ -225,7 +227,6 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
                 )
             requested[restart] = 0.0  # NEXT_STEP: the action of a finished satellite is ignored
         (reward, terminated, truncated, dv), obs = task_model.step_and_observe(task, self._state, requested)
-        # As Gymnasium's TimeLimit: at the horizon an episode is truncated even if it also terminated.
         infos: dict[str, Any] = {"burn_m_s": dv, "_burn_m_s": self._everyone_mask}
         if restart.size:
             # NEXT_STEP: the satellites that ended in the last step start anew instead.
@@ -258,7 +259,8 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
             infos["_burn_m_s"] = ~done
             obs[finished] = self._restart(finished)
         self._last_obs = obs
-        return obs, reward, terminated, truncated, infos
+        # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
+        return obs, reward, done.copy(), np.zeros(self.num_envs, dtype=np.bool_), infos
 
     def _outcome(self, reentered: NDArray[np.bool_], mask: NDArray[np.bool_]) -> dict[str, Any]:
         """The episodes so far, for ``info`` (`OUTCOME_KEYS`, each with its mask as Gymnasium's vector API)."""

@@ -268,6 +268,29 @@ def test_make_sb3_vec_env_is_monitored_for_ep_rew_mean_and_evaluate_policy(tmp_p
     assert monitors(plain) == 0
 
 
+@pytest.mark.parametrize("bootstrap", [False, True])
+def test_bootstrap_at_horizon_marks_only_the_missions_that_reach_it_as_truncated(tmp_path, bootstrap):
+    # The environments end every mission terminated; `bootstrap_at_horizon = true` has SB3 bootstrap past the
+    # horizon (TimeLimit.truncated) where a mission ended in orbit, never where it re-entered.
+    from orbit_env.agents.train import load_config, training_env
+
+    text = TINY.replace('shaping = "never_burn_value"', 'shaping = "none"').replace(
+        "end_decided = 1.0", "end_decided = 0.0"
+    )
+    text = text.replace("bootstrap_at_horizon = false", f"bootstrap_at_horizon = {str(bootstrap).lower()}")
+    config = load_config(write(tmp_path, text))
+    assert config["bootstrap_at_horizon"] is bootstrap and config["shaping"] == "none"
+    venv = training_env(config)
+    venv.reset()
+    seen = {True: 0, False: 0}
+    for _ in range(2 * config["env"].get("horizon_steps", 30)):
+        _, _, dones, infos = venv.step(np.zeros(venv.num_envs, dtype=np.int64))
+        for i in np.flatnonzero(dones):
+            assert infos[i]["TimeLimit.truncated"] is (bootstrap and not infos[i]["reentered"])
+            seen[infos[i]["reentered"]] += 1
+    assert seen[True] > 0 and seen[False] > 0, seen
+
+
 def test_training_and_sweep_envs_monitor_once(monkeypatch, tmp_path):
     from orbit_env.agents import sweep as sweep_module
     from orbit_env.agents.train import load_config, training_env

@@ -130,19 +130,20 @@ def test_make_vec_gives_the_numpy_batched_env(env_id):
     [{"horizon_steps": 10}, {"config": OrbitRaisingConfig(horizon_steps=10)}, {"config": {"horizon_steps": 10}}],
     ids=["flat", "object", "dict"],
 )
-def test_horizon_steps_alone_sets_the_truncation_and_the_clock(kwargs):
+def test_horizon_steps_alone_sets_the_missions_end_and_the_clock(kwargs):
     start = {"perigee_km": 500.0, "apogee_km": 1000.0}  # outlives the mission
     env = make("OrbitRaising-v0", **kwargs)
     env.reset(seed=0, options=start)
-    for k in range(1, 11):
-        obs, _, terminated, truncated, _ = env.step(0)
-        assert obs[3] == pytest.approx(k / 10) and not terminated and truncated == (k == 10)
+    for k in range(1, 11):  # the mission's end is terminal, never truncated (orbit_env.envs)
+        obs, _, terminated, truncated, info = env.step(0)
+        assert obs[3] == pytest.approx(k / 10) and terminated == (k == 10) and not truncated
+        assert not info["reentered"]
     vec = make_vec("OrbitRaising-v0", 2, **kwargs)
     vec.reset(seed=0, options=start)
     for k in range(1, 11):
-        obs, _, terminated, truncated, _ = vec.step(np.zeros(2, dtype=np.int64))
+        obs, _, terminated, truncated, info = vec.step(np.zeros(2, dtype=np.int64))
         np.testing.assert_allclose(obs[:, 3], k / 10, rtol=1e-6)
-        assert not terminated.any() and (truncated == (k == 10)).all()
+        assert (terminated == (k == 10)).all() and not truncated.any() and not info["reentered"].any()
     with pytest.raises(ValueError, match=r"max_episode_steps=20 but horizon_steps=10; pass horizon_steps=20"):
         make_vec("OrbitRaising-v0", 2, max_episode_steps=20, **kwargs)
     make_vec("OrbitRaising-v0", 2, max_episode_steps=10, **kwargs).reset(seed=0)  # the same number is accepted
@@ -353,21 +354,22 @@ def test_single_and_vector_envs_step_in_lock_step(env_id):
     active = np.ones(n, dtype=bool)
     ends = set()
     for action in actions:
-        obs_v, reward_v, terminated_v, truncated_v, _ = vec.step(action)
+        obs_v, reward_v, terminated_v, truncated_v, info_v = vec.step(action)
         state_v = vec.unwrapped.state
         for i in np.flatnonzero(active):
-            obs_s, reward_s, terminated_s, truncated_s, _ = singles[i].step(action[i])
+            obs_s, reward_s, terminated_s, truncated_s, info_s = singles[i].step(action[i])
             assert (terminated_v[i], truncated_v[i]) == (terminated_s, truncated_s)
+            assert info_v["reentered"][i] == info_s["reentered"] and not truncated_s
             np.testing.assert_allclose(reward_v[i], reward_s, rtol=1e-9, atol=1e-12)
             np.testing.assert_allclose(obs_v[i], obs_s, rtol=1e-6, atol=1e-7)
             state_s = singles[i].unwrapped.state
             for key, value in state_s.items():
                 np.testing.assert_allclose(state_v[key][i], value, rtol=1e-9, atol=1e-12, err_msg=key)
-            if terminated_s or truncated_s:
+            if terminated_s:
                 active[i] = False
-                ends.add("terminated" if terminated_s else "truncated")
+                ends.add("re-entered" if info_s["reentered"] else "mission's end")
     assert not active.any(), "every episode ends at the horizon at the latest"
-    assert ends == {"terminated", "truncated"}, "the test must see both ways an episode ends"
+    assert ends == {"re-entered", "mission's end"}, "the test must see both ways an episode ends"
 
 
 #: One start orbit for every episode (a 240 km circular orbit), so that the automatic resets of
@@ -395,7 +397,7 @@ def test_vector_env_steps_in_lock_step_with_sync_vector_env(env_id, mode):
     obs_s, _ = sync.reset(seed=1)
     np.testing.assert_allclose(obs_v, obs_s, rtol=1e-6, atol=1e-7)
     actions = random_actions(vec.action_space, 3 * SHORT, seed=9)
-    seen = {"terminated": 0, "truncated": 0, "restarted": 0}
+    seen = {"re-entered": 0, "mission's end": 0, "restarted": 0}
     for action in actions:
         obs_v, reward_v, terminated_v, truncated_v, info_v = vec.step(action)
         obs_s, reward_s, terminated_s, truncated_s, info_s = sync.step(action)
@@ -405,8 +407,10 @@ def test_vector_env_steps_in_lock_step_with_sync_vector_env(env_id, mode):
         np.testing.assert_array_equal(truncated_v, truncated_s)
         assert_infos_match(info_v, info_s, "burn_m_s")
         done = terminated_s | truncated_s
-        seen["terminated"] += int(terminated_s.sum())
-        seen["truncated"] += int((truncated_s & ~terminated_s).sum())
+        assert not truncated_s.any()  # the mission's end is terminal too
+        ended = info_s["final_info"] if mode is AutoresetMode.SAME_STEP and done.any() else info_s
+        seen["re-entered"] += int((terminated_s & ended["reentered"]).sum())
+        seen["mission's end"] += int((terminated_s & ~ended["reentered"]).sum())
         if mode is AutoresetMode.SAME_STEP:
             assert ("final_obs" in info_v) == done.any() == ("final_obs" in info_s)
             if done.any():
@@ -915,7 +919,7 @@ def test_sb3_adapter_follows_sb3s_episode_convention():
     venv = make_sb3_vec_env("OrbitRaising-v0", num_envs=16, seed=3, config=config, max_episode_steps=SHORT)
     obs = venv.reset()
     assert obs.shape == (16, 7)
-    seen = {"terminated": 0, "truncated": 0}
+    seen = {"terminated": 0, "mission's end": 0}
     for _ in range(SHORT + 1):
         actions = np.array([venv.action_space.sample() for _ in range(16)])
         obs, rewards, dones, infos = venv.step(actions)
@@ -923,8 +927,10 @@ def test_sb3_adapter_follows_sb3s_episode_convention():
         for i in np.flatnonzero(dones):
             assert obs[i, 3] == 0.0  # the returned observation starts the next mission
             assert infos[i]["terminal_observation"][3] > 0.0
-            seen["truncated" if infos[i]["TimeLimit.truncated"] else "terminated"] += 1
-    assert seen["terminated"] > 0 and seen["truncated"] > 0
+            # Both ends are terminal: SB3 bootstraps no value past either.
+            assert infos[i]["TimeLimit.truncated"] is False
+            seen["terminated" if infos[i]["reentered"] else "mission's end"] += 1
+    assert seen["terminated"] > 0 and seen["mission's end"] > 0
     venv.set_options({"perigee_km": 300.0, "apogee_km": 300.0})
     np.testing.assert_allclose(venv.reset()[:, 0], 0.3, atol=1e-4)
 

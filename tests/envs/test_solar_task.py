@@ -201,7 +201,8 @@ def test_an_empty_tank_that_cannot_comply_pays_the_penalty() -> None:
         total += reward
         if terminated or truncated:
             break
-    assert truncated and not info["complies"] and info["disposal_dv_m_s"] == 0.0
+    assert terminated and not truncated and not info["reentered"]  # the mission's end, terminal
+    assert not info["complies"] and info["disposal_dv_m_s"] == 0.0
     cost = task.config.propellant_cost_per_m_s
     expected = info["days_in_orbit"] - cost * info["dv_used_m_s"] - task.penalty_days
     assert total == pytest.approx(expected, abs=1e-6)
@@ -274,12 +275,14 @@ def test_the_single_env_steps_as_the_task_model() -> None:
             obs, reward, terminated, truncated, info = env.step(int(action))
             result = st.step(task, state, np.array([task.requested_dv(int(action))]))
             np.testing.assert_array_equal(obs, st.observe(task, state)[0])
-            assert (reward, terminated, truncated) == (result.reward[0], result.terminated[0], result.truncated[0])
+            # The env's terminated: the task's re-entry or mission's end; never truncated.
+            ended = bool(result.terminated[0] or result.truncated[0])
+            assert (reward, terminated, truncated) == (result.reward[0], ended, False)
             assert info["burn_m_s"] == result.burn_m_s[0]
-            if terminated or truncated:
+            if terminated:
                 break
         np.testing.assert_array_equal(env.unwrapped.task_state.data, state.data)
-        if truncated:
+        if result.truncated[0]:
             assert (info["disposal_dv_m_s"], info["complies"]) == (result.disposal_m_s[0], result.complies[0])
             judged += 1
     assert judged  # the mission's end, its rule and the observation after the disposal burn, compared too
@@ -291,7 +294,7 @@ def test_the_vector_env_restarts_on_the_next_step() -> None:
     assert obs.shape == (6, 11) and env.single_observation_space.contains(obs[0])
     for _ in range(3):
         obs, reward, terminated, truncated, info = env.step(np.zeros(6, dtype=np.int64))
-    assert truncated.all() and info["_complies"].all()
+    assert terminated.all() and not truncated.any() and info["_complies"].all()
     obs, reward, terminated, truncated, info = env.step(np.full(6, 3))
     assert (reward == 0.0).all() and not (terminated | truncated).any()
     assert (info["dv_used_m_s"] == 0.0).all() and (info["days_in_orbit"] == 0.0).all()
@@ -335,7 +338,10 @@ def test_the_vector_envs_same_step_autoreset_is_gymnasiums_sync_vector_envs() ->
         np.testing.assert_array_equal(obs_v[same & ~done], obs_s[same & ~done])
         if not done.any():
             continue
-        ends.update("terminated" if terminated_s[i] else "truncated" for i in np.flatnonzero(done))
+        assert not truncated_s.any()  # the mission's end is terminal too
+        ends.update(
+            "re-entered" if info_s["final_info"]["reentered"][i] else "mission's end" for i in np.flatnonzero(done)
+        )
         final_v, final_s = info_v["final_obs"], info_s["final_obs"]
         assert final_v.dtype == object and final_v.shape == final_s.shape == (n,)
         for i in range(n):
@@ -349,9 +355,9 @@ def test_the_vector_envs_same_step_autoreset_is_gymnasiums_sync_vector_envs() ->
                 if (mask & same).any():
                     np.testing.assert_array_equal(which_v[key][mask & same], which_s[key][mask & same], err_msg=key)
         same &= ~done
-        if ends == {"terminated", "truncated"}:
+        if ends == {"re-entered", "mission's end"}:
             break
-    assert ends == {"terminated", "truncated"}, "the test must see both ways a mission ends"
+    assert ends == {"re-entered", "mission's end"}, "the test must see both ways a mission ends"
 
 
 def test_the_optimum_beats_every_rule_on_its_mission() -> None:
