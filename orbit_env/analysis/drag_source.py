@@ -32,6 +32,7 @@ from orbit_env.analysis.drag_calibration import (
 )
 from orbit_env.analysis.lifetime import PAPER_DRAG_COEFFICIENT, Satellite, make_satellite
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
+from orbit_env.constants import REENTRY_ALTITUDE_M
 
 #: What ``drag_parameter_source`` says in JSON.
 SOURCE_BSTAR = "bstar"
@@ -41,6 +42,12 @@ SOURCE_DEFAULT = "default"
 #: ``--drag-from``: what of an element set gives the drag parameter.
 DRAG_FROM_SOURCES = {"bstar": SOURCE_BSTAR_CALIBRATED, "ndot": SOURCE_NDOT_CALIBRATED}
 DRAG_FROM_DEFAULT = "bstar"
+#: How each source of one set reads the drag, for messages.
+READ_AS = {
+    SOURCE_BSTAR_CALIBRATED: "its B* calibrated to this air at its epoch",
+    SOURCE_NDOT_CALIBRATED: "its ndot calibrated to this air at its epoch",
+    SOURCE_BSTAR: "2 B*/rho0",
+}
 DRAG_FROM_CHOICES = (*DRAG_FROM_SOURCES, "bstar-raw")
 
 
@@ -142,7 +149,8 @@ def drag_source(
             no_fit = f"no history fit: {why}; from the latest set alone"
         else:
             report = {"drag_fit": fit.report()}
-            return DragSource(Satellite(1.0, 1.0, fit.drag_parameter_m2_kg), SOURCE_HISTORY_FIT, report)
+            satellite = _drag_satellite(fit.drag_parameter_m2_kg, "the decay between the sets")
+            return DragSource(satellite, SOURCE_HISTORY_FIT, report)
     if not inputs.given and elements is not None and elements.bstar_per_earth_radius is not None:
         c, source, calibration_report = drag_from_elements(elements, scenario, inputs.drag_from or DRAG_FROM_DEFAULT)
         report = {"bstar_per_earth_radius": elements.bstar_per_earth_radius, "ndot_rev_day2": elements.ndot_rev_day2}
@@ -150,9 +158,23 @@ def drag_source(
         if no_fit is not None:
             report["drag_note"] = no_fit
         # c_x 1 on an area of c m^2 per kg: the drag parameter is what the decay uses.
-        return DragSource(Satellite(1.0, 1.0, c), source, report)
+        return DragSource(_drag_satellite(c, f"the element set ({READ_AS[source]})"), source, report)
     satellite = make_satellite(cx, inputs.mass_kg, inputs.area_m2, inputs.mass_per_area_kg_m2)
     return DragSource(satellite, SOURCE_SATELLITE if inputs.given else SOURCE_DEFAULT)
+
+
+def _drag_satellite(c: float, where: str) -> Satellite:
+    """The satellite of a drag parameter read from element sets (c_x 1 on c m^2 per kg), or an error saying so.
+
+    The satellite's own check names its mass per area and area, which the user never gave.
+    """
+    try:
+        return Satellite(1.0, 1.0, c)
+    except ValueError:
+        raise ValueError(
+            f"{where} gives a drag parameter c_x A/m = {c:.4g} m^2/kg (G/F = {1.0 / c:.4g} kg/m^2 at c_x 1), "
+            "outside any satellite's; give the satellite: --mass and --area (or --shape)"
+        ) from None
 
 
 def drag_from_elements(elements: Any, scenario: Any, how: str = DRAG_FROM_DEFAULT) -> tuple[float, str, dict[str, Any]]:
@@ -232,6 +254,21 @@ def drag_sigma(source: DragSource) -> float | None:
     return ONE_SET_DRAG_SIGMA if source.source in one_set else None
 
 
+def _beyond_the_curves(elements: Any, offset_m: float) -> str:
+    """Why a batch cannot decay an element set's orbit, in the row's own heights (km flown, as its columns)."""
+    from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
+
+    limits_m = (REENTRY_ALTITUDE_M, CURVES_MAX_PERIGEE_M, CURVES_MAX_APOGEE_M)
+    low, top, apogee_top = ((h - offset_m) / 1e3 for h in limits_m)
+    flown = f"the orbit flown, {elements.flown_perigee_km:.1f} x {elements.flown_apogee_km:.1f} km"
+    if elements.flown_perigee_km < low:
+        return f"{flown}, has its perigee below the re-entry height ({low:.1f} km here): it is re-entering"
+    return (
+        f"{flown}, is outside the universal curves, on which a batch decays (perigee {low:.1f} to {top:.1f} km, "
+        f"apogee up to {apogee_top:.1f} km here); orbit-env lifetime --tle follows it by the averaged equations"
+    )
+
+
 def element_set_orbits(
     sets: list[Any], satellite: Satellite, scenario: Any, *, satellite_given: bool, offset_m: float = 0.0
 ) -> BatchOrbits:
@@ -279,7 +316,7 @@ def element_set_orbits(
         if status[i] == "ok":
             try:
                 UniversalCurves.check_domain(hp[i], ha[i])
-            except ValueError as error:
-                status[i] = f"line {latest[i].line}: {error}"
+            except ValueError:  # its message names metres above the sphere; the row shows km flown
+                status[i] = f"line {latest[i].line}: {_beyond_the_curves(latest[i], offset_m)}"
     epochs = np.array([s.epoch_days for s in latest], dtype=np.float64)
     return BatchOrbits(rows, hp, ha, c, inc, status, sigma, epochs)

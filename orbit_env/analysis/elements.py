@@ -250,14 +250,14 @@ def read_tle(path: str | Path) -> list[ElementSet]:
         OSError: the file cannot be read.
     """
     if str(path) == "-":
-        return parse_tle_text(sys.stdin.read().splitlines(), "<stdin>")
-    with open(path) as handle:
+        return parse_tle_text(sys.stdin.read().removeprefix("\ufeff").splitlines(), "<stdin>")
+    with open(path, encoding="utf-8-sig") as handle:  # a byte-order mark (Windows' editors) is no part of a name
         return parse_tle_text(handle.read().splitlines(), str(path))
 
 
 def looks_like_tle(path: str | Path) -> bool:
     """Whether a file's first non-blank lines are an element set (rather than a CSV's header)."""
     # A look only: bytes that are not text make no element set, and the CSV reader names the file.
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = [line.rstrip() for line in handle.readlines()[:6] if line.strip()]
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:
+        lines = [line.strip() for line in handle.readlines()[:6] if line.strip()]  # indented as pasted: as read_tle
     return any(line.startswith("1 ") and len(line) == TLE_LINE_LENGTH for line in lines[:2])

@@ -57,7 +57,7 @@ def _satellite(args: argparse.Namespace) -> Satellite:
     return make_satellite(cx, args.mass, args.area, args.mass_per_area)
 
 
-def _atmosphere(args: argparse.Namespace, scenario: Scenario, *, batch: bool = False) -> str:
+def _atmosphere(args: argparse.Namespace, scenario: Scenario, *, batch: bool = False, result: Any = None) -> str:
     """The atmosphere line; says so when the inclination it depends on is the default, not the user's.
 
     With ``batch``, the inclination is each row's (its ``inclination_deg``), ``--inclination`` only
@@ -65,6 +65,10 @@ def _atmosphere(args: argparse.Namespace, scenario: Scenario, *, batch: bool = F
     so does the date of a batch of element sets, each row's air from its own epoch.
     """
     text = scenario.describe(args.inclination)
+    if result is not None and result.method == "averaged" and scenario.epoch_days is not None:
+        # Above the curves' domain a dated decay is not stepped: one mean air over the life (lifetime_mean).
+        steps = f" in {scenario.chunk_days:g}-day steps"
+        text = text.replace(steps, ", averaged over the lifetime (the orbit lies above the universal curves)")
     if batch and getattr(args, "rows_own_epochs", False) and scenario.epoch_days is not None:
         own = "from each row's epoch (its latest element set) in"
         text = text.replace(f"from {iso_date(scenario.epoch_days)} in", own)
@@ -187,14 +191,14 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
 
         plot_history(result, args.plot, activity=scenario.activity, height_offset_km=offset, band_days=band)
     if args.json:
-        summary["atmosphere"] = _atmosphere(args, scenario)
+        summary["atmosphere"] = _atmosphere(args, scenario, result=result)
         print(_json(summary))
         return 0
     check_finite(summary, "the result")
     for line in orbit_inputs.orbit_lines(orbit, args.inclination):
         print(line)
     print(orbit_inputs.satellite_line(drag))
-    print(f"atmosphere         {_atmosphere(args, scenario)}")
+    print(f"atmosphere         {_atmosphere(args, scenario, result=result)}")
     print(f"nu                 {result.nu:.4g} m^3/(kg s^2)")
     print(f"revolutions        {result.revolutions:.1f}")
     if result.reentered:
@@ -209,11 +213,12 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     print(f"perigee velocity   {result.perigee_velocity_m_s:.1f} m/s")
     print(f"method             {result.method}")
     if rule is not None:
+        label = f"{args.rule:g}-year rule"  # in the labels' column, whatever the rule's digits
         if rule.complies[0]:
-            print(f"{args.rule:g}-year rule       complies (re-enters within {args.rule:g} years)")
+            print(f"{label:<19}complies (re-enters within {args.rule:g} years)")
         else:
             print(
-                f"{args.rule:g}-year rule       does not comply; smallest burn at apogee: {rule.dv_m_s[0]:.2f} m/s "
+                f"{label:<19}does not comply; smallest burn at apogee: {rule.dv_m_s[0]:.2f} m/s "
                 f"(retrograde), lowering the perigee to {rule.new_perigee_m[0] / 1e3 - offset:.1f} km"
             )
     return 0
@@ -410,7 +415,10 @@ def add_parsers(sub: Any) -> None:
     _add_atmosphere_options(life)
     life.add_argument("--rule", type=number, metavar="YEARS", help="disposal rule: re-entry within YEARS (25, 5)")
     life.add_argument(
-        "--batch", metavar="CSV", help="lifetimes of every orbit in a CSV file (see orbit_env.analysis.catalogue)"
+        "--batch",
+        metavar="FILE",
+        help="lifetimes of every orbit in a CSV file, or of every object in a file of element sets (each object's "
+        "sets its history; see orbit_env.analysis.catalogue)",
     )
     life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
     life.add_argument(

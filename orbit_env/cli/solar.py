@@ -2,7 +2,7 @@
 
 ``orbit-env solar show`` says which record is in use and what it covers;
 ``orbit-env solar update FILE`` imports a newer CelesTrak space-weather file
-(``SW-All.txt`` from https://celestrak.org/SpaceData/) that the user downloaded.
+(``SW-All.txt`` or ``SW-Last5Years.txt`` from https://celestrak.org/SpaceData/) that the user downloaded.
 Nothing is downloaded here. See `orbit_env.decay.solar_record`.
 """
 
@@ -41,6 +41,10 @@ def add_parsers(sub: Any) -> None:
     actions = solar.add_subparsers(dest="solar_command", required=True, parser_class=type(solar))
     show = actions.add_parser("show", help="which space-weather record is in use, and its dates")
     show.set_defaults(func=_cmd_show)
-    update = actions.add_parser("update", help="import a CelesTrak space-weather file you downloaded (SW-All.txt)")
-    update.add_argument("file", metavar="FILE", help="CelesTrak's SW-All.txt (https://celestrak.org/SpaceData/)")
+    update = actions.add_parser(
+        "update", help="import a CelesTrak space-weather file you downloaded (SW-All.txt or SW-Last5Years.txt)"
+    )
+    update.add_argument(
+        "file", metavar="FILE", help="CelesTrak's SW-All.txt or SW-Last5Years.txt (https://celestrak.org/SpaceData/)"
+    )
     update.set_defaults(func=_cmd_update)

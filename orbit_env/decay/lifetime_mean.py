@@ -30,11 +30,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, Trajectory, integrate_averaged
 from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.curves import days_from_weighted_s
 from orbit_env.physics.atmosphere.msis import interpolate_log_density
+from orbit_env.physics.orbit import elements_from_heights, period_s
 
 FloatArray = NDArray[np.float64]
 
@@ -93,6 +94,25 @@ def _days(trajectory: Trajectory, drag_parameter_m2_kg: float) -> float:
     return float(days_from_weighted_s(trajectory.weighted_s[-1], drag_parameter_m2_kg))
 
 
+def _first_metre_days(perigee_m: float, apogee_m: float, drag_parameter_m2_kg: float, decay: DecayModel) -> float:
+    """Days the parameter p takes to fall its first metre at the start's rate (inf: no decay at all).
+
+    dt = P dnu / (g c) (nu counts revolutions times g c), so dt/dp = P / (g c dp/dnu). Drag grows as the
+    orbit comes down, so the whole life is longer than this: a lower bound.
+    """
+    p, e = elements_from_heights(perigee_m, apogee_m)
+    dp_dnu = float(decay.rates_per_nu(p, e)[0])
+    if not dp_dnu < 0.0:
+        return math.inf
+    return float(period_s(p, e)) / (G0_M_S2 * drag_parameter_m2_kg * -dp_dnu) / SECONDS_PER_DAY
+
+
+def _staying(perigee_m: float, apogee_m: float) -> Trajectory:
+    """The trajectory of an orbit that stays: its start, twice."""
+    _, e = elements_from_heights(perigee_m, apogee_m)
+    return Trajectory(np.zeros(2), np.zeros(2), np.full(2, perigee_m), np.full(2, apogee_m), np.full(2, float(e)))
+
+
 def mean_air_model(model: SolarDecayModel, atmosphere: MeanProfileAtmosphere) -> DecayModel:
     """The averaged equations' model in a mean profile (the chunked model's air options)."""
     return DecayModel(atmosphere, model.rotating_atmosphere, model.inclination_deg)
@@ -111,6 +131,10 @@ def mean_air_lifetime(
     for _ in range(PASSES):
         atmosphere = mean_profile(model, window)
         decay = mean_air_model(model, atmosphere)
+        if _first_metre_days(perigee_m, apogee_m, drag_parameter_m2_kg, decay) > cap_days:
+            # Still up at the cap for certain (drag only grows as the orbit comes down): no integration, which
+            # fails where drag hardly touches the orbit (a geostationary satellite in co-rotating air).
+            return MeanAirLifetime(cap_days, False, _staying(perigee_m, apogee_m), atmosphere, decay)
         trajectory = integrate_averaged(perigee_m, apogee_m, decay)
         days = _days(trajectory, drag_parameter_m2_kg) if perigee_m > REENTRY_ALTITUDE_M else 0.0
         window = min(max(days, SAMPLE_DAYS), cap_days)

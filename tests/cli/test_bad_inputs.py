@@ -377,3 +377,63 @@ def test_a_solar_file_error_names_its_physical_line(capsys, tmp_path):
     table.write_text("date,f107\n2013-10-01,100\n\n2013-10-02,lots\n")
     status, _, err = run(capsys, *ORBIT, "--atmosphere", "msis", "--solar-csv", table)
     assert status == 2 and err == f"orbit-env: error: {table}, line 4: f107='lots' is not a number\n"
+
+
+# ------------------------------------------------------------------------------------------
+# Element sets and mean elements that no decay starts from: said in their own terms (a review's
+# findings: the messages named --perigee, --area or a mass per area the user never gave).
+
+GEO_TLE = """GEO-TEST
+1 99998U 24001B   24100.50000000  .00000000  00000-0  10000-3 0  9997
+2 99998   0.0500 120.0000 0001000  90.0000 270.0000  1.00270000    14
+"""
+BELOW_GROUND_TLE = """ECC5
+1 99996U 24001C   24100.50000000  .00002000  00000-0  25000-3 0  9993
+2 99996  51.6000 120.0000 5000000  90.0000 270.0000 15.05164753    10
+"""
+CUBESAT_TLE = """CUBESAT-550 (synthetic)
+1 99999U 24001A   24100.50000000  .00002000  00000-0  25000-3 0  9996
+2 99999  97.5000 120.0000 0010000  90.0000 270.0000 15.05164753    18
+"""
+
+
+def test_an_element_set_below_the_ground_or_the_reentry_height_says_so(capsys, tmp_path):
+    below = tmp_path / "below.tle"
+    below.write_text(BELOW_GROUND_TLE)
+    status, _, err = run(capsys, "lifetime", "--tle", below)
+    assert status == 2
+    assert "the element set (a = 6929.910 km, e = 0.5000000) is flown at -2913.9 x 4016.0 km" in err
+    assert "below the Earth's surface" in err and "--area" not in err
+    status, _, err = run(capsys, "lifetime", "--semi-major-axis-km", "12800", "--eccentricity", "0.5")
+    assert status == 2
+    assert "--semi-major-axis-km/--eccentricity (a = 12800.000 km, e = 0.5000000) is flown at 16.7 x" in err
+    assert "below the re-entry height (100 km above the 6371 km sphere, 92.9 km here)" in err
+    assert "--perigee" not in err
+
+
+def test_a_drag_no_satellite_has_names_where_it_came_from(capsys, tmp_path):
+    # B* 1e-4 at 35 786 km, calibrated to NRLMSIS there: 3619 m^2/kg, a mass per area of 0.0003 kg/m^2.
+    geo = tmp_path / "geo.tle"
+    geo.write_text(GEO_TLE)
+    status, _, err = run(capsys, "lifetime", "--tle", geo)
+    assert status == 2
+    assert "the element set (its B* calibrated to this air at its epoch) gives a drag parameter c_x A/m = 3619" in err
+    assert "give the satellite: --mass and --area" in err and "mass_kg / area_m2" not in err
+
+
+def test_a_batch_of_element_sets_reads_them_as_pasted_and_says_why_a_row_is_beyond_it(capsys, tmp_path):
+    # Indented lines and a byte-order mark (a Windows editor's), as --tle reads them; a geostationary
+    # object's row says in its own km why a batch, which decays on the curves, leaves it out.
+    sets = tmp_path / "sets.tle"
+    text = "".join("   " + line + "\n" for line in (GEO_TLE + CUBESAT_TLE).splitlines())
+    sets.write_bytes("\ufeff".encode() + text.encode())
+    out = tmp_path / "out.csv"
+    status, _, err = run(
+        capsys, "lifetime", "--batch", sets, "--out", out, "--no-progress", "--mass", "4", "--area", "0.03"
+    )
+    assert status == 1 and "1 of 2 rows have no lifetime" in err
+    rows = list(csv.DictReader(out.open()))
+    assert [r["name"] for r in rows] == ["GEO-TEST", "CUBESAT-550 (synthetic)"]  # no byte-order mark in a name
+    assert rows[0]["status"].startswith("line 2: the orbit flown, 35782.4 x 35790.8 km, is outside the universal")
+    assert "perigee 92.9 to 1092.9 km" in rows[0]["status"] and "perigee_m" not in rows[0]["status"]
+    assert rows[1]["status"] == "ok" and float(rows[1]["days"]) > 0.0

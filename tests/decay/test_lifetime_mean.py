@@ -52,3 +52,31 @@ def test_the_mean_air_agrees_with_the_time_stepped_curves_on_long_lives(perigee_
     mean = mean_air_lifetime(perigee_km * 1e3, apogee_km * 1e3, STAGE.drag_parameter_m2_kg, model)
     assert stepped.days > 9 * 365.25
     assert mean.days == pytest.approx(stepped.days, rel=0.05)
+
+
+def test_a_geostationary_satellite_in_co_rotating_air_stays_up_instead_of_failing(capsys):
+    # Co-rotating air moves with a geostationary satellite: drag hardly touches it, and the averaged
+    # equations could not follow a decay that does not happen ("Required step size is less than spacing
+    # between numbers"). Its first metre at the start's rate outlasts the 200 years the propagation
+    # follows (drag only grows as an orbit comes down), so it is still up there; a GTO is not.
+    from orbit_env.decay import lifetime_mean
+    from orbit_env.decay.averaged import DecayModel
+    from orbit_env.physics.atmosphere import ExponentialAtmosphere
+
+    air = ExponentialAtmosphere()  # the law for orbital heights (Vallado's band from 400 km)
+    geo = 35789.5e3, 35797.9e3  # above the 6371 km sphere, 0.05 deg (a GEO element set's flown orbit)
+    turning, still = DecayModel(air, True, 0.05), DecayModel(air, False, 0.05)
+    c = STAGE.drag_parameter_m2_kg
+    assert lifetime_mean._first_metre_days(*geo, c, turning) > lifetime_mean._first_metre_days(*geo, c, still)
+    assert lifetime_mean._first_metre_days(*geo, c, still) > 200 * 365.25
+    assert lifetime_mean._first_metre_days(250e3, 35786e3, c, turning) < 1.0
+    life = lifetime(35782.4, 35790.8, satellite=STAGE, epoch="2024-04-09", inclination_deg=0.05, method="curves")
+    assert not life.reentered and life.days == pytest.approx(200 * 365.25) and life.method == "averaged"
+    # The command says so, and that its air is the lifetime's mean, not steps of 20 days.
+    from orbit_env.cli import main
+
+    argv = "lifetime --perigee 35775.3 --apogee 35783.7 --inclination 0.05 --epoch 2024-04-09 --mass 1000 --area 10"
+    assert main([*argv.split(), "--cx", "2.2"]) == 0
+    out = capsys.readouterr().out
+    assert "still in orbit after 200 years" in out and "method             averaged" in out
+    assert "averaged over the lifetime (the orbit lies above the universal curves)" in out and "day steps" not in out
