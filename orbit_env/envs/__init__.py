@@ -41,6 +41,12 @@ __all__ = [
     "register_envs",
 ]
 
+#: What a single environment warns when stepped after its episode ended (as CartPole-v1 warns): call reset().
+ENDED_WARNING = (
+    "step() called after the episode ended (terminated=True): the satellite re-entered or the mission is over, "
+    "and what a step returns now means nothing; call reset()"
+)
+
 _ENTRY_POINT = "orbit_env.envs.orbit_raising:OrbitRaisingEnv"
 _VECTOR_ENTRY_POINT = "orbit_env.envs.vector:OrbitRaisingVectorEnv"
 

@@ -15,6 +15,7 @@ import numpy as np
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
+from orbit_env.envs import ENDED_WARNING
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DEFAULT_HORIZON_STEPS, DensityConfig, OrbitRaisingConfig, resolve_task_arguments
 from orbit_env.envs.task import Task, TaskState, TaskView
@@ -241,6 +242,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         self._last_burn_m_s = 0.0
         self._dv_used_m_s = 0.0  # the burns of the episode so far, for info["dv_used_m_s"]
         self._renderer: Any = None
+        self._ended = False  # the episode has ended: a step now warns, as CartPole's does
 
     @property
     def spec(self) -> EnvSpec | None:
@@ -308,6 +310,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         state = self._state
         self._last_burn_m_s = 0.0
         self._dv_used_m_s = 0.0
+        self._ended = False
         if self.render_mode is not None:
             self._track = [(state.perigee_m, state.apogee_m, 0.0)]
             if self.render_mode == "human":
@@ -319,6 +322,8 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
         state = self._state
         if state is None:
             raise RuntimeError("call reset() before step()")
+        if self._ended:
+            gym.logger.warn(ENDED_WARNING)
         task = self.task
         requested = task.requested_dv(action)
         result = task_model.step(task, state, requested)
@@ -334,10 +339,11 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
             if self.render_mode == "human":
                 self.render()
         # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
+        self._ended = bool(result.terminated or result.truncated)
         return (
             task_model.observe(task, state),
             result.reward,
-            bool(result.terminated or result.truncated),
+            self._ended,
             False,
             {"burn_m_s": result.burn_m_s, **self._outcome()},
         )

@@ -18,7 +18,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
-from orbit_env.envs import solar_task
+from orbit_env.envs import ENDED_WARNING, solar_task
 from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.solar_task import SOLAR_CONFIG, SOLAR_OBS_NAMES, SolarMission, SolarTask
 from orbit_env.envs.state import ROW, BatchState
@@ -108,6 +108,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     Terminated at re-entry (perigee 100 km) and after 61 steps, with the rule judged: the mission's
     end is part of the task (its disposal is charged there), so ``truncated`` is never set
     (`orbit_env.envs`, "The mission's end is terminal"); ``info["reentered"]`` tells the two apart.
+    A shorter mission is ``horizon_steps``; ``gymnasium.make``'s own ``max_episode_steps`` wraps the
+    environment in Gymnasium's ``TimeLimit``, which cuts the mission off (``truncated``, no rule judged).
     ``info``: ``burn_m_s``, ``reentered``, ``days_in_orbit``, ``dv_used_m_s``, ``date`` (the
     next step's first day, ISO); at the end also ``disposal_dv_m_s`` and ``complies``.
 
@@ -147,6 +149,7 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._state: BatchState | None = None
         self._dv_used_m_s = 0.0
         self._last: dict[str, Any] = {}
+        self._ended = False  # the episode has ended: a step now warns, as CartPole's does
         # Pictures ("human", "rgb_array"): the (apogee, perigee) plane with the track, as the known-density envs
         # draw it (`orbit_env.envs.render.TrackRenderer`); (perigee [m], apogee [m], the month's burn [m/s]).
         self._drawn = render_mode in ("human", "rgb_array")
@@ -190,6 +193,7 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         self._state = solar_task.start(self.task, self.np_random, 1, options)
         self._start = solar_task.start_options(self._state)
         self._dv_used_m_s = 0.0
+        self._ended = False
         if self._drawn:
             self._track = [(float(self._state.perigee_m[0]), float(self._state.apogee_m[0]), 0.0)]
             if self.render_mode == "human":
@@ -201,6 +205,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
         state = self._state
         if state is None:
             raise RuntimeError("call reset() before step()")
+        if self._ended:
+            gym.logger.warn(ENDED_WARNING)
         obs, reward, terminated, truncated, burn, disposal, complies = solar_task.step_and_observe_one(
             self.task, state, self.task.requested_dv(action)
         )
@@ -217,7 +223,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
             if self.render_mode == "human":
                 self.render()
         # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
-        return obs, reward, terminated or truncated, False, info
+        self._ended = terminated or truncated
+        return obs, reward, self._ended, False, info
 
     def _outcome(self) -> dict[str, Any]:
         data = self._state.data  # a batch of one: column 0 (read directly, as the step is timed against CartPole's)
@@ -265,7 +272,9 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
     """``num_envs`` solar missions stepped together (see `OrbitRaisingSolarEnv` for the task).
 
     Batched as Gymnasium's vector API: observations (num_envs, 11), actions (num_envs,), ``info``
-    the single environment's keys as arrays with their ``_key`` masks. Finished missions restart
+    the single environment's keys as arrays with their ``_key`` masks (``date`` as ``datetime64[D]``,
+    where the single environment's is an ISO string and Gymnasium's own vector environments gather
+    those strings in an object array). Finished missions restart
     as ``autoreset_mode`` says (``NEXT_STEP``, the default, or ``SAME_STEP`` with
     ``info["final_obs"]`` and ``info["final_info"]``).
     """

@@ -213,6 +213,27 @@ def test_sb3_infos_hold_each_finished_episodes_outcome():
     assert finished[1]["reentered"] is False and finished[1]["dv_used_m_s"] == 0.0
 
 
+@pytest.mark.parametrize("env_id", [*ENV_IDS, SOLAR_ENV_ID])
+def test_a_step_after_the_end_warns_as_cartpoles_does(env_id):
+    import warnings
+
+    env = gym.make(env_id, horizon_steps=2)
+    env.reset(seed=0)
+    for _ in range(2):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            *_, terminated, _, _ = env.step(env.action_space.sample() * 0)
+        assert not [w for w in caught if "after the episode ended" in str(w.message)]
+    assert terminated
+    with pytest.warns(UserWarning, match=r"step\(\) called after the episode ended .* call reset\(\)"):
+        env.step(env.action_space.sample() * 0)
+    env.reset(seed=1)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        env.step(env.action_space.sample() * 0)
+    assert not [w for w in caught if "after the episode ended" in str(w.message)]
+
+
 def test_sb3_infos_hold_the_solar_missions_end():
     # The solar task's end: its date, the disposal burn and the verdict reach SB3's infos too.
     pytest.importorskip("stable_baselines3")
