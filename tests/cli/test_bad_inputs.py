@@ -397,11 +397,17 @@ CUBESAT_TLE = """CUBESAT-550 (synthetic)
 """
 
 
-def test_an_element_set_below_the_ground_or_the_reentry_height_says_so(capsys, tmp_path):
-    below = tmp_path / "below.tle"
-    below.write_text(BELOW_GROUND_TLE)
-    status, _, err = run(capsys, "lifetime", "--tle", below)
+def tle_error(capsys, tmp_path, text):
+    """What ``lifetime --tle`` says of an element set it refuses (usage error: status 2)."""
+    path = tmp_path / "set.tle"
+    path.write_text(text)
+    status, _, err = run(capsys, "lifetime", "--tle", path)
     assert status == 2
+    return err
+
+
+def test_an_element_set_below_the_ground_or_the_reentry_height_says_so(capsys, tmp_path):
+    err = tle_error(capsys, tmp_path, BELOW_GROUND_TLE)
     assert "the element set (a = 6929.910 km, e = 0.5000000) is flown at -2913.9 x 4016.0 km" in err
     assert "below the Earth's surface" in err and "--area" not in err
     status, _, err = run(capsys, "lifetime", "--semi-major-axis-km", "12800", "--eccentricity", "0.5")
@@ -413,10 +419,7 @@ def test_an_element_set_below_the_ground_or_the_reentry_height_says_so(capsys, t
 
 def test_a_drag_no_satellite_has_names_where_it_came_from(capsys, tmp_path):
     # B* 1e-4 at 35 786 km, calibrated to NRLMSIS there: 3619 m^2/kg, a mass per area of 0.0003 kg/m^2.
-    geo = tmp_path / "geo.tle"
-    geo.write_text(GEO_TLE)
-    status, _, err = run(capsys, "lifetime", "--tle", geo)
-    assert status == 2
+    err = tle_error(capsys, tmp_path, GEO_TLE)
     assert "the element set (its B* calibrated to this air at its epoch) gives a drag parameter c_x A/m = 3619" in err
     assert "give the satellite: --mass and --area" in err and "mass_kg / area_m2" not in err
 
