@@ -56,7 +56,7 @@ class CsvTable:
         for column in columns:
             if column not in self.header:
                 found = ", ".join(self.header) or "nothing"
-                raise ValueError(f"{self.source}: {what} needs the column '{column}'; its header has {found}")
+                raise ValueError(f"{self.source}: {what} needs the '{column}' column; its header has {found}")
 
 
 def cell_value(text: str) -> float | str:
