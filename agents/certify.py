@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, task_of
+from orbit_env.envs import SOLAR_ENV_ID
 
 FloatArray = NDArray[np.float64]
 
@@ -72,6 +73,7 @@ class Certificate:
     plans_scored: int
     replay_max_error: float = field(default=0.0)
     start_dates: tuple[str, ...] = ()  # the solar task's missions' first days
+    policy_name: str = "DP policy"  # what was certified: the DP's, or a caller's ("policy" and its class name)
 
     @property
     def gaps(self) -> FloatArray:
@@ -93,6 +95,7 @@ class Certificate:
             **({"worst_start_date": self.start_dates[worst]} if self.start_dates else {}),
             "beaten_above_0.1_day": int(np.sum(gaps > 0.1)),
             "beaten_at_all": int(np.sum(gaps > TIE_DAYS)),
+            "policy": self.policy_name,
             "dp_mean_return": float(self.dp_returns.mean()),
             "plans_scored": int(self.plans_scored),
             "replay_max_error_days": float(self.replay_max_error),
@@ -295,7 +298,7 @@ def _solar_optimum(
     DPs are solved in ``workers`` processes (default: the cores, at most 8), as ``evaluate`` does.
     """
     from orbit_env.agents.solar import map_missions, starts
-    from orbit_env.envs import SOLAR_ENV_ID, solar_task
+    from orbit_env.envs import solar_task
 
     probe = gymnasium.make(SOLAR_ENV_ID, **env_kwargs)
     task = probe.unwrapped.task
@@ -346,8 +349,6 @@ def certify(
         ValueError: an unknown env, one whose density is not known (its optimum is the
             oracle's), or counts below 1.
     """
-    from orbit_env.envs import SOLAR_ENV_ID
-
     if episodes < 1 or rounds < 0 or perturbations < 1:
         raise ValueError("episodes and perturbations must be >= 1, rounds >= 0")
     say = progress or (lambda text: None)
@@ -403,23 +404,28 @@ def certify(
         plans_scored=plans.scored,
         replay_max_error=replay_error,
         start_dates=optimum.start_dates,
+        policy_name="DP policy" if policy is None else f"policy {type(policy).__name__}",
     )
 
 
 def format_certificate(summary: dict[str, Any]) -> str:
     """The certificate as text for people."""
+    policy = summary.get("policy", "DP policy")
+    replayed = "the winners in gymnasium.make" + (
+        "; the solar DP's own in the vector env" if summary["env"] == SOLAR_ENV_ID else ""
+    )
     return "\n".join(
         [
-            f"{summary['env']}: a search for plans that beat the DP policy on {summary['episodes']} starts "
+            f"{summary['env']}: a search for plans that beat the {policy} on {summary['episodes']} starts "
             f"(seed {summary['seed']}), {summary['plans_scored']:,} plans scored in {summary['wall_s']:.0f} s",
-            f"DP policy's mean return {summary['dp_mean_return']:.3f} days",
-            f"gap found (best plan - DP policy): mean {summary['mean_gap_days']:.3f} day, "
+            f"{policy}'s mean return {summary['dp_mean_return']:.3f} days",
+            f"gap found (best plan - {policy}): mean {summary['mean_gap_days']:.3f} day, "
             f"worst {summary['worst_gap_days']:.3f} day (episode {summary['worst_episode']}, "
             f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km"
             + (f", from {summary['worst_start_date']})" if "worst_start_date" in summary else ")"),
-            f"starts where the DP was beaten: {summary['beaten_at_all']} by more than {TIE_DAYS} day, "
+            f"starts where the {'DP' if policy == 'DP policy' else policy} was beaten: {summary['beaten_at_all']} "
+            f"by more than {TIE_DAYS} day, "
             f"{summary['beaten_above_0.1_day']} by more than 0.1 day",
-            f"plans replayed (the winners in gymnasium.make; the solar DP's own in the vector env): largest "
-            f"difference {summary['replay_max_error_days']:.1e} day",
+            f"plans replayed ({replayed}): largest difference {summary['replay_max_error_days']:.1e} day",
         ]
     )

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 from orbit_env.agents.policies import HAND_CODED
-from orbit_env.envs import ENV_IDS
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
 
 FloatArray = NDArray[np.float64]
 
@@ -70,9 +70,44 @@ class Episodes:
 
 
 def check_env_id(env_id: str) -> None:
-    """ValueError unless ``env_id`` is one of the package's environments."""
+    """ValueError unless ``env_id`` is a known-density environment (the solar task has an evaluation of its own)."""
+    if env_id == SOLAR_ENV_ID:
+        raise ValueError(
+            f"{SOLAR_ENV_ID} is scored by orbit_env.agents.solar.evaluate_solar (its missions, a DP each); "
+            f"here: {', '.join(ENV_IDS)}"
+        )
     if env_id not in ENV_IDS:
-        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join(ENV_IDS)}")
+        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join((*ENV_IDS, SOLAR_ENV_ID))}")
+
+
+def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any]:
+    """``policy.predict``'s deterministic actions for a batch of observations, checked against ``space``.
+
+    ``space`` is one environment's action space. A discrete action must be a whole number of its range and a
+    Box action finite, one row per observation: an action the environment itself would refuse is an error
+    naming the policy, not an action quietly rounded or wrapped (2.7 was the 30 m/s burn, -1 the largest).
+    """
+    name = type(policy).__name__
+    rows = len(observations)
+    returned = policy.predict(observations, deterministic=True)
+    if not (isinstance(returned, tuple) and len(returned) == 2):
+        raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
+    try:
+        actions = np.asarray(returned[0], dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}.predict returned actions that are not numbers: {returned[0]!r:.80}") from None
+    shape = (rows, *space.shape)
+    if actions.shape != shape:
+        raise ValueError(f"{name}.predict returned actions of shape {actions.shape}, not {shape} ({rows} observations)")
+    if not np.all(np.isfinite(actions)):
+        raise ValueError(f"{name}.predict returned an action that is not finite: {actions[~np.isfinite(actions)][0]}")
+    if isinstance(space, gymnasium.spaces.Discrete):
+        whole = (actions == np.round(actions)) & (actions >= space.start) & (actions < space.start + space.n)
+        if not whole.all():
+            allowed = f"whole numbers in [{space.start}, {space.start + space.n - 1}]"
+            raise ValueError(f"{name}.predict returned action {actions[~whole][0]:g}; allowed: {allowed}")
+        return actions.astype(np.int64)
+    return actions.astype(space.dtype)
 
 
 def run_episodes(
@@ -106,7 +141,7 @@ def run_episodes(
         if hasattr(policy, "bind"):
             policy.bind(env, rows)  # an oracle reads the hidden state it is told
         actions[...] = 0
-        actions[rows], _ = policy.predict(obs[rows], deterministic=True)
+        actions[rows] = predicted_actions(policy, obs[rows], env.single_action_space)
         obs, reward, terminated, truncated, info = env.step(actions)
         burn = np.asarray(info["burn_m_s"], dtype=np.float64)
         returns += np.where(running, reward, 0.0)
@@ -329,8 +364,6 @@ def load_model(
         ValueError: a missing file, one that does not load, or spaces that do not fit.
     """
     from importlib import resources
-
-    from orbit_env.envs import SOLAR_ENV_ID
 
     if env_id != SOLAR_ENV_ID:
         check_env_id(env_id)

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.agents.evaluate import Episodes
+from orbit_env.agents.evaluate import Episodes, predicted_actions
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.envs import solar_task
 from orbit_env.envs import task as task_model
@@ -239,8 +239,7 @@ def by_model(task: SolarTask, model: Any) -> Callable[[BatchState], FloatArray]:
     sizes = np.array(task.config.burn_sizes_m_s)
 
     def act(state: BatchState) -> FloatArray:
-        actions, _ = model.predict(solar_task.observe(task, state), deterministic=True)
-        return sizes[np.asarray(actions, dtype=np.int64).reshape(-1)]
+        return sizes[predicted_actions(model, solar_task.observe(task, state), task.action_space)]
 
     return act
 

@@ -52,6 +52,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     from orbit_env.envs import SOLAR_ENV_ID
 
     if args.certify:
+        given = [flag for flag, value in (("--model", args.model), ("--plot", args.plot)) if value]
+        if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
+            raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
         return _certify(args, say)
     if args.env == SOLAR_ENV_ID:
         return _evaluate_solar(args, say)
@@ -75,7 +78,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         "paired_to_dp": paired_difference(results, name=learned, baseline="dp"),
     }
     if args.json:
-        out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, "policies": table}
+        out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, **_yardsticks(args), "policies": table}
         out.update({key: pair for key, pair in paired.items() if pair is not None})
         print(json.dumps(out))
     else:
@@ -84,9 +87,15 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _yardsticks(args: argparse.Namespace, *, lookahead: bool = True) -> dict[str, Any]:
+    """What made the rows of a JSON result that its reader cannot see: which DP policy, which model."""
+    dp = {"lookahead": args.dp_lookahead, "rollout": args.dp_rollout} if lookahead else {"rollout": args.dp_rollout}
+    return {"dp_policy": None if args.no_dp else dp, "model": args.model if args.model is not None else "shipped"}
+
+
 def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
-    from orbit_env.agents.evaluate import format_table, load_model, paired_difference, summarize
+    from orbit_env.agents.evaluate import format_table, load_model, paired_difference, plot_returns, summarize
     from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
 
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
@@ -104,6 +113,8 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         learned=learned,
     )
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
+    if args.plot:
+        plot_returns(results, args.env, args.plot)
     table = summarize(results)
     report = solar_report(evaluation)
     # Episode by episode: the learned agent and the optimum against the best operators' rule,
@@ -122,6 +133,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
             "seed": args.seed,
             "solar_split": args.solar_split,
             "disposal_years": args.disposal_years,
+            **_yardsticks(args, lookahead=False),  # the solar DP's policy has no look-ahead setting
             "policies": {name: {**row, **report["policies"][name]} for name, row in table.items()},
             **{key: value for key, value in report.items() if key != "policies"},
         }

@@ -109,6 +109,45 @@ def test_apogee_threshold_burns_only_below_threshold():
     assert burns[0] == 100.0 and burns[1] == 0.0
 
 
+class Returns:
+    """A policy whose predict returns what ``make`` makes of the observations (a bad policy's stand-in)."""
+
+    def __init__(self, make):
+        self.make = make
+
+    def predict(self, observations, deterministic=True):
+        return self.make(observations), None
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda o: np.full(len(o), 2.7), r"Returns.predict returned action 2.7; allowed: whole numbers in \[0, 3\]"),
+        (lambda o: np.full(len(o), -1), r"returned action -1; allowed: whole numbers in \[0, 3\]"),
+        (lambda o: np.full(len(o), np.nan), r"returned an action that is not finite: nan"),
+        (lambda o: np.zeros((len(o), 1)), r"returned actions of shape \(5, 1\), not \(5,\) \(5 observations\)"),
+        (lambda o: ["a"] * len(o), r"returned actions that are not numbers"),
+    ],
+    ids=["fraction", "negative", "nan", "shape", "text"],
+)
+def test_a_policys_bad_actions_are_refused_naming_it_not_rounded_or_wrapped(make, message):
+    # evaluate wrote them into an int64 array: 2.7 flew the 30 m/s burn, and in the solar task -1 the largest.
+    from orbit_env.agents.solar import fly_model
+
+    with pytest.raises(ValueError, match=message):
+        run_episodes("OrbitRaising-v0", Returns(make), episodes=5, seed=0)
+    with pytest.raises(ValueError, match=message.replace("(5", "(3").replace("5 obs", "3 obs")):
+        fly_model(Returns(make), 3, 0)
+    assert run_episodes("OrbitRaising-v0", Returns(lambda o: np.full(len(o), 2.0)), episodes=5, seed=0).returns.size
+
+
+def test_the_solar_task_is_sent_to_its_own_evaluation_and_every_id_is_named():
+    with pytest.raises(ValueError, match=r"OrbitRaisingSolar-v0 is scored by orbit_env.agents.solar.evaluate_solar"):
+        run_episodes("OrbitRaisingSolar-v0", NeverBurn(), episodes=2)
+    with pytest.raises(ValueError, match=r"allowed: OrbitRaising-v0, .*, OrbitRaisingSolar-v0$"):
+        run_episodes("Foo-v0", NeverBurn(), episodes=2)
+
+
 @pytest.mark.parametrize("env_id", sorted(evaluate_module.SHIPPED_MODELS))
 def test_the_shipped_models_load_to_act_without_unpickling_their_schedules(env_id):
     # The schedules are closures that another cloudpickle cannot rebuild: SB3 warned "Could not deserialize
@@ -159,6 +198,8 @@ def test_evaluate_cli_json_without_dp(capsys):
     assert out["env"] == "OrbitRaising-v0" and out["episodes"] == 8
     assert {"never", "all_at_once", "apogee_threshold", "greedy", "ppo"} <= set(out["policies"])
     assert out["paired_difference"]["policy"] == "ppo"
+    # A submission says what made the rows its reader cannot see: no DP here, the shipped model.
+    assert out["dp_policy"] is None and out["model"] == "shipped"
 
 
 @pytest.mark.parametrize(

@@ -33,6 +33,12 @@ def test_the_search_beats_a_policy_that_never_burns_and_replays_its_winners():
     # Every winner's return is the one gymnasium.make gives when the plan is replayed.
     assert summary["replay_max_error_days"] < 1e-6
     assert summary["plans_scored"] == 12 * (1 + 64 + 4)  # the policy, 4^3 early plans, the perturbations
+    # It names the policy it certified, not the DP's (it said "DP policy's mean return" of any policy).
+    from orbit_env.agents.certify import format_certificate
+
+    text = format_certificate(summary)
+    assert summary["policy"] == "policy NeverBurn" and "policy NeverBurn's mean return" in text
+    assert "DP" not in text and "solar" not in text
 
 
 def test_the_search_rarely_beats_a_good_policy_by_much():
@@ -78,3 +84,10 @@ def test_the_solar_certificate_flies_each_missions_own_dp_and_replays_its_plan()
     assert summary["plans_scored"] == 2 * (1 + 64 + 3)  # the DP's plan, 4^3 early plans, the perturbations
     # The test split's missions start on or after 2009-01-01.
     assert summary["worst_start_date"] >= "2009-01-01" and len(summary["worst_start_date"]) == 10
+
+
+def test_certify_refuses_the_options_it_would_ignore(capsys):
+    from orbit_env.cli import main
+
+    assert main(["evaluate", "--certify", "--plot", "x.png", "--model", "m.zip"]) == 2
+    assert "--certify searches plans against the DP policy: it takes no --model or --plot" in capsys.readouterr().err
