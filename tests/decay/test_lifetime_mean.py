@@ -80,3 +80,18 @@ def test_a_geostationary_satellite_in_co_rotating_air_stays_up_instead_of_failin
     out = capsys.readouterr().out
     assert "still in orbit after 200 years" in out and "method             averaged" in out
     assert "averaged over the lifetime (the orbit lies above the universal curves)" in out and "day steps" not in out
+
+
+def test_a_first_pass_far_beyond_the_cap_needs_no_second(monkeypatch):
+    # A 2000 km orbit lives ~10^5 years in one solar cycle's mean air; the second pass's air (every day of
+    # the cap's 200 years) could not bring that under the cap (`FAR_BEYOND`): one profile, still up.
+    from orbit_env.decay import lifetime_mean
+    from orbit_env.decay.solar import ConstantActivity
+
+    profiles = []
+    original = lifetime_mean.mean_profile
+    monkeypatch.setattr(lifetime_mean, "mean_profile", lambda *a: profiles.append(a[1]) or original(*a))
+    model = MsisAir(ConstantActivity(150.0, 150.0, 15.0), unix_days(EPOCH)).solar_model(0.0)
+    life = mean_air_lifetime(2007.137e3, 2007.137e3, STAGE.drag_parameter_m2_kg, model)
+    assert not life.reentered and life.days == pytest.approx(200 * 365.25)
+    assert profiles == [lifetime_mean.FIRST_WINDOW_DAYS]
