@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel, Trajectory, integrate_averaged
 from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.curves import days_from_weighted_s
@@ -102,14 +102,14 @@ def _days(trajectory: Trajectory, drag_parameter_m2_kg: float) -> float:
 def _first_metre_days(perigee_m: float, apogee_m: float, drag_parameter_m2_kg: float, decay: DecayModel) -> float:
     """Days the parameter p takes to fall its first metre at the start's rate (inf: no decay at all).
 
-    dt = P dnu / (g c) (nu counts revolutions times g c), so dt/dp = P / (g c dp/dnu). Drag grows as the
-    orbit comes down, so the whole life is longer than this: a lower bound.
+    The metre's weighted time is W = P dnu = P / |dp/dnu| (one metre of p), in days by `days_from_weighted_s`.
+    Drag grows as the orbit comes down, so the whole life is longer than this: a lower bound.
     """
     p, e = elements_from_heights(perigee_m, apogee_m)
     dp_dnu = float(decay.rates_per_nu(p, e)[0])
     if not dp_dnu < 0.0:
         return math.inf
-    return float(period_s(p, e)) / (G0_M_S2 * drag_parameter_m2_kg * -dp_dnu) / SECONDS_PER_DAY
+    return float(days_from_weighted_s(float(period_s(p, e)) / -dp_dnu, drag_parameter_m2_kg))
 
 
 def _staying(perigee_m: float, apogee_m: float) -> Trajectory:

@@ -180,23 +180,32 @@ class MsisAir(Air):
         """Dated: the mean of each day's orbit-averaged density over the span, with the days' indices (and season)."""
         if not self.dated or epoch_days is None:
             return super().density_near_kg_m3(altitude_m, inclination_deg, epoch_days, span_days)
-        import numpy as np
-
-        from orbit_env.decay.solar import day_of_year
         from orbit_env.physics.atmosphere.msis import mean_density_over_days_kg_m3
 
-        days = float(epoch_days) - np.arange(span_days)[::-1]
-        f107, f107a, ap = self.solar.indices(days)
+        f107, f107a, ap, day_of_year = self._days_read(float(epoch_days), span_days)
         return mean_density_over_days_kg_m3(
             altitude_m,
             f107,
             f107a,
             ap,
-            day_of_year(days),
+            day_of_year,
             inclination_deg,
             self.ascending_node_local_time_h,
             version=self.version,
         )
+
+    def _days_read(self, epochs_days: Any, span_days: int) -> Any:
+        """F10.7, its 81-day mean, Ap and the day of the year of the ``span_days`` days up to each epoch.
+
+        What `density_near_kg_m3` hands NRLMSIS, and so what `near_description` digests: one place for both.
+        Shape (4, *epochs' shape, span_days).
+        """
+        import numpy as np
+
+        from orbit_env.decay.solar import day_of_year
+
+        days = np.asarray(epochs_days, dtype=np.float64)[..., None] - np.arange(span_days)[::-1]
+        return np.stack([*self.solar.indices(days), day_of_year(days)])
 
     def near_description(self, epochs_days: Any, span_days: int) -> str | None:
         """Dated: the version, the node's local time and a digest of the indices and days of the year NRLMSIS reads.
@@ -209,10 +218,7 @@ class MsisAir(Air):
 
         import numpy as np
 
-        from orbit_env.decay.solar import day_of_year
-
-        days = np.asarray(epochs_days, dtype=np.float64)[:, None] - np.arange(span_days)[::-1]
-        read = np.stack([*self.solar.indices(days), day_of_year(days)])
+        read = self._days_read(epochs_days, span_days)
         digest = hashlib.sha256(np.ascontiguousarray(read, dtype=np.float64).tobytes()).hexdigest()
         return f"MsisAir dated version={self.version!r} node={self.ascending_node_local_time_h!r} days={digest}"
 
