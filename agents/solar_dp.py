@@ -108,6 +108,24 @@ def _weights(axis: FloatArray, x: FloatArray) -> tuple[NDArray[np.intp], FloatAr
     return i, (x - axis[i]) / (axis[i + 1] - axis[i])
 
 
+def _corners(
+    grid: SolarGrid, label: FloatArray, tau: FloatArray
+) -> tuple[NDArray[np.intp], FloatArray, NDArray[np.intp], FloatArray]:
+    """The grid cells of points (label, tau) and their upper weights (with an axis for the levels)."""
+    i, wi = _weights(grid.labels, np.maximum(label, MU_LOW))
+    j, wj = _weights(grid.taus, tau)
+    return i, wi[..., None], j, wj[..., None]
+
+
+def _interpolate(
+    table: FloatArray, i: NDArray[np.intp], wi: FloatArray, j: NDArray[np.intp], wj: FloatArray
+) -> FloatArray:
+    """``table`` (L, T, K) bilinear in (label, tau) at `_corners`: shape (*S, K)."""
+    return (1.0 - wi) * ((1.0 - wj) * table[i, j] + wj * table[i, j + 1]) + wi * (
+        (1.0 - wj) * table[i + 1, j] + wj * table[i + 1, j + 1]
+    )
+
+
 def _grid_states(task: SolarTask, grid: SolarGrid, dv_left: float, day: float) -> BatchState:
     """The grid's points as states of the task's satellite with ``dv_left`` on day ``day``."""
     mu, tau = np.meshgrid(grid.labels, grid.taus, indexing="ij")
@@ -128,6 +146,8 @@ class SolarDP:
         self.task = task
         self.start_day = float(start_day)
         self.grid = grid = solar_grid(task)
+        # Where each burn lands, as interpolation corners (the same for every stage).
+        self._burn_corners = {made: _corners(grid, *point) for made, point in grid.burn_points.items()}
         config, block = task.config, task.mission.block_days
         n_l, n_t, n_k = grid.labels.size, grid.taus.size, grid.levels.size
         cost = config.propellant_cost_per_m_s
@@ -193,21 +213,16 @@ class SolarDP:
                 if made <= 0.0:
                     continue
                 levels = np.flatnonzero(grid.burn_made[a] == made)
-                label, tau = grid.burn_points[float(made)]
-                q = self._bilinear(after, label, tau)[..., grid.burn_index[a, levels]] - cost * made
+                # Only the levels the burn lands on are interpolated (each level's numbers are its own).
+                corners = self._burn_corners[float(made)]
+                q = _interpolate(after[:, :, grid.burn_index[a, levels]], *corners) - cost * made
                 best[:, :, levels] = np.maximum(best[:, :, levels], q)
         best[:, 0, :] = 0.0
         return best
 
     def _bilinear(self, table: FloatArray, label: FloatArray, tau: FloatArray) -> FloatArray:
         """``table`` (L, T, K) at points (label, tau) of any shape S: shape (*S, K)."""
-        grid = self.grid
-        i, wi = _weights(grid.labels, np.maximum(label, MU_LOW))
-        j, wj = _weights(grid.taus, tau)
-        wi, wj = wi[..., None], wj[..., None]
-        return (1.0 - wi) * ((1.0 - wj) * table[i, j] + wj * table[i, j + 1]) + wi * (
-            (1.0 - wj) * table[i + 1, j] + wj * table[i + 1, j + 1]
-        )
+        return _interpolate(table, *_corners(self.grid, label, tau))
 
     def _at_level(self, values: FloatArray, dv_left: FloatArray) -> FloatArray:
         """Rows of ``values`` (n, K) interpolated at each row's delta-v left."""
