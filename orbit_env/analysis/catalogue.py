@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.analysis.catalogue_io import ID_COLUMNS, LINE_KEY, format_value
+from orbit_env.analysis.catalogue_io import DRAG_SOURCE_KEY, ID_COLUMNS, LINE_KEY, format_value
 from orbit_env.analysis.disposal import check_disposal_rule
 from orbit_env.analysis.inclination_spread import inclination_log_ratio, spread_lifetime_days
 from orbit_env.analysis.lifetime import (
@@ -307,6 +307,10 @@ def batch_lifetimes(
             apogee_km=format_value(apogee_m[i] / 1e3),
             inclination_deg=format_value(inclination_deg[i]),
             drag_parameter_m2_kg=format_value(drag_parameter_m2_kg[i]),
+        )
+        if DRAG_SOURCE_KEY in row:  # element sets: where the row's drag came from
+            record[DRAG_SOURCE_KEY] = row[DRAG_SOURCE_KEY]
+        record.update(
             days=format_value(days[i]) if status[i] == "ok" and reentered[i] else "",
             years=format_value(days[i] / 365.25) if status[i] == "ok" and reentered[i] else "",
         )

@@ -50,6 +50,8 @@ FloatArray = NDArray[np.float64]
 
 #: Columns copied to the output to name a row.
 ID_COLUMNS = ("name", "id")
+#: A batch of element sets' column saying where each row's drag came from (JSON's ``drag_parameter_source``).
+DRAG_SOURCE_KEY = "drag_parameter_source"
 
 #: Key of a row's physical line in the rows of `read_batch` (a header name is stripped of
 #: spaces, so no column can be called this).
@@ -186,35 +188,6 @@ def read_batch(
 def format_value(value: float) -> str:
     """A number as the results file writes it: six significant digits, empty if not finite."""
     return "" if not np.isfinite(value) else f"{value:.6g}"
-
-
-def check_output(path: str | Path, input_path: str | Path, *, force: bool = False) -> None:
-    """Refuse, before any computing, an output that would replace the input, or an existing file, or cannot be written.
-
-    Args:
-        path: The results file.
-        input_path: The catalogue it is computed from.
-        force: Replace an existing results file (never the input).
-
-    Raises:
-        ValueError: ``path`` is the input file (also through a link), exists and
-            ``force`` is off, is a directory, or its directory is missing or not writable.
-    """
-    out, source = Path(path), Path(input_path)
-    if (out.exists() and source.exists() and os.path.samefile(out, source)) or out.resolve() == source.resolve():
-        raise ValueError(f"--out {path} is the input file; the results go to another file")
-    if out.is_dir():
-        raise ValueError(f"--out {path} is a directory; give a file name")
-    if out.exists() and not force:
-        raise ValueError(f"--out {path} exists; give --force to replace it, or another file name")
-    folder = out.parent
-    if not folder.is_dir():
-        raise ValueError(f"--out {path}: the folder {folder} does not exist")
-    try:
-        with tempfile.TemporaryFile(dir=folder):
-            pass
-    except OSError as error:
-        raise ValueError(f"--out {path}: cannot write in {folder} ({error.strerror or error})") from None
 
 
 @contextmanager

@@ -90,7 +90,12 @@ def read_observations(path: str | Path) -> Observations:
     """
     table = read_csv(path)
     source = table.source
-    table.require("perigee_km", "apogee_km", what="the observations")
+    if table.header and table.header[0].startswith("1 ") and len(table.header[0]) >= 60:
+        raise ValueError(
+            f"{source} holds element sets, not observed orbits (date, perigee_km, apogee_km): an element set "
+            "history's drag is fitted by orbit-env lifetime --tle FILE"
+        )
+    table.require("perigee_km", "apogee_km", what="the observations file")
     if "date" in table.header and "days" in table.header:
         raise ValueError(
             f"{source}: the times are in two columns, 'date' and 'days'; keep one (one time axis for every row)"
@@ -255,7 +260,7 @@ def fit_density_scale(
 
     Raises:
         ValueError: too few observations, a re-entry before the first orbit, heights
-            outside the curves, or an orbit fit on a time-varying scenario.
+            outside the curves, or an orbit that does not come down from the first observation to the last.
     """
     c = satellite.drag_parameter_m2_kg
     try:
@@ -277,6 +282,13 @@ def fit_density_scale(
     n = hp.size
     if n < 3:
         raise ValueError(f"an orbit fit needs at least 3 observations, got {n} (or give --reentry)")
+    rise_km = (hp[-1] + ha[-1] - hp[0] - ha[0]) / 2e3
+    if not rise_km < 0.0:  # drag only lowers an orbit: these are not one decay
+        raise ValueError(
+            f"the orbit does not come down between the first and the last observation (its mean height "
+            f"{rise_km:+.3f} km over {observations.days[-1] - observations.days[0]:.1f} days): a manoeuvre, or "
+            "observations of more than one decay"
+        )
     if scenario.time_varying:
         return _plausible(_fit_orbits_time_varying(observations, hp, ha, c, scenario, inclination_deg))
     curves = scenario.curves(inclination_deg)
@@ -343,9 +355,12 @@ def _fit_orbits_time_varying(
         )
     start = float(observations.days[0])
     if scenario.epoch_days is None or abs(scenario.epoch_days - start) > 1e-6:
+        from orbit_env.analysis.lifetime import iso_datetime
+
+        air = "an undated air" if scenario.epoch_days is None else f"air from {iso_datetime(scenario.epoch_days)}"
         raise ValueError(
-            f"the air starts on {scenario.epoch_days} (unix days) but the first observation is on {start}: "
-            "fit from the first observation's date (give no --epoch, or that date)"
+            f"the fit starts at the first observation ({iso_datetime(start)}), in the air of its days, not in {air}: "
+            "give no --epoch (or the first observation's date)"
         )
     t = observations.days - start
     model = replace(scenario.solar_model(inclination_deg, max_years=float(t[-1]) / 365.25 + 0.1), chunk_days=1.0)

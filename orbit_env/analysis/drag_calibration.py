@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env import cache
+from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
 from orbit_env.workers import in_two_processes
 
@@ -179,15 +180,17 @@ class DragFit:
         drag_parameter_m2_kg: c that reproduces the decay in the air.
         sets: How many sets the fit used.
         span_days: From the first fitted set to the last.
-        residual_km: RMS of the mean semi-major axes about the fitted decay.
+        residual_km: RMS of the mean semi-major axes about the fitted decay; None for two sets (the
+            fit goes through both).
         sigma_ln: Standard error of ln c from the residuals (a floor of the air's day-to-day
-            error is not included; see `orbit_env.analysis.uncertainty`).
+            error is not included; see `orbit_env.analysis.uncertainty`); for two sets, which leave
+            no residual, one set's scatter (`orbit_env.analysis.uncertainty.ONE_SET_DRAG_SIGMA`).
     """
 
     drag_parameter_m2_kg: float
     sets: int
     span_days: float
-    residual_km: float
+    residual_km: float | None
     sigma_ln: float
 
     def report(self) -> dict[str, float | int]:
@@ -224,7 +227,7 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     da/dt = -(a^2 / mu) c <rho_air v^3> F_rot, is integrated day by day in the air of each
     day along the observed orbit (the semi-major axes interpolated between the sets) and c
     is the least-squares fit of the measured drops to c times the integral. Sets older than
-    `HISTORY_SPAN_DAYS` before the latest are left out.
+    `HISTORY_SPAN_DAYS` before the latest are left out, and sets of the same epoch count once.
 
     Raises:
         NoHistoryToFit: fewer than two sets a day apart in the span.
@@ -235,7 +238,9 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     if len(numbers) > 1:
         raise ValueError(f"a history is one object's sets; these are of {', '.join(numbers)}")
     latest = max(s.epoch_days for s in history)
-    sets = sorted((s for s in history if latest - s.epoch_days <= HISTORY_SPAN_DAYS), key=lambda s: s.epoch_days)
+    # A set given twice (downloads joined into one file) is one measurement: one set per epoch, the last read.
+    sets = list({s.epoch_days: s for s in history if latest - s.epoch_days <= HISTORY_SPAN_DAYS}.values())
+    sets.sort(key=lambda s: s.epoch_days)
     if len(sets) < 2 or sets[-1].epoch_days - sets[0].epoch_days < HISTORY_STEP_DAYS:
         raise NoHistoryToFit(
             f"a drag fit needs sets at least a day apart within {HISTORY_SPAN_DAYS:g} days of the latest; "
@@ -281,8 +286,9 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
             f"the semi-major axis does not fall between these {len(sets)} sets "
             f"({(drop[-1]) / 1e3:+.3f} km over {t[-1] - t[0]:.1f} days): a manoeuvre, or too short a span to fit"
         )
+    if len(sets) == 2:  # the fit goes through both: no residual to judge it by, so one set's scatter
+        return DragFit(c, 2, float(t[-1] - t[0]), None, ONE_SET_DRAG_SIGMA)
     residual = drop[1:] - c * unit_drop[1:]
-    dof = max(1, len(sets) - 2)
-    rms = float(np.sqrt(np.sum(residual**2) / dof)) if len(sets) > 2 else 0.0
+    rms = float(np.sqrt(np.sum(residual**2) / (len(sets) - 2)))
     sigma_c = rms / math.sqrt(float(np.dot(unit_drop[1:], unit_drop[1:])))
     return DragFit(c, len(sets), float(t[-1] - t[0]), rms / 1e3, sigma_c / c)

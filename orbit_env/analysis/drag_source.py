@@ -16,12 +16,13 @@ The command line (`orbit_env.cli.orbit_inputs`) only reads the flags into
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from orbit_env.analysis.catalogue_io import BatchOrbits
+from orbit_env.analysis.catalogue_io import DRAG_SOURCE_KEY, BatchOrbits
 from orbit_env.analysis.drag_calibration import (
     SOURCE_BSTAR_CALIBRATED,
     SOURCE_HISTORY_FIT,
@@ -177,6 +178,17 @@ def _drag_satellite(c: float, where: str) -> Satellite:
         ) from None
 
 
+class NoDragInSet(ValueError):
+    """An element set whose decay term (B* or ndot, ``value`` as the set gives it) is not above zero."""
+
+    def __init__(self, value: str) -> None:
+        self.value = value
+        super().__init__(
+            f"the element set's {value} gives no drag parameter (it must be above 0); give the satellite: "
+            "--mass and --area (or --shape)"
+        )
+
+
 def drag_from_elements(elements: Any, scenario: Any, how: str = DRAG_FROM_DEFAULT) -> tuple[float, str, dict[str, Any]]:
     """The drag parameter one element set carries: (c [m^2/kg], its source's name, the calibration's report).
 
@@ -184,27 +196,20 @@ def drag_from_elements(elements: Any, scenario: Any, how: str = DRAG_FROM_DEFAUL
     the set's epoch; ``bstar-raw``: 2 B*/rho0 against SGP4's own density).
 
     Raises:
-        ValueError: the set carries no decay (B* or ndot not above zero): give the satellite.
+        NoDragInSet: the set carries no decay (B* or ndot not above zero): give the satellite.
     """
     if how == "bstar-raw":
         c = elements.drag_parameter_m2_kg
         if c is None:
-            raise ValueError(
-                f"the element set's B* = {elements.bstar_per_earth_radius:g} /ER gives no drag parameter "
-                "(it must be above 0); give the satellite: --mass and --area (or --shape)"
-            )
+            raise NoDragInSet(f"B* = {elements.bstar_per_earth_radius:g} /ER")
         return c, SOURCE_BSTAR, {}
     source = DRAG_FROM_SOURCES[how]
     calibration = calibrate(elements, scenario, source=source)
     if calibration is None:
-        value = (
+        raise NoDragInSet(
             f"ndot = {elements.ndot_rev_day2:g} rev/day^2"
             if source == SOURCE_NDOT_CALIBRATED
             else f"B* = {elements.bstar_per_earth_radius:g} /ER"
-        )
-        raise ValueError(
-            f"the element set's {value} gives no drag parameter (it must be above 0); give the satellite: "
-            "--mass and --area (or --shape)"
         )
     return calibration.drag_parameter_m2_kg, calibration.source, calibration.report()
 
@@ -270,15 +275,25 @@ def _beyond_the_curves(elements: Any, offset_m: float) -> str:
 
 
 def element_set_orbits(
-    sets: list[Any], satellite: Satellite, scenario: Any, *, satellite_given: bool, offset_m: float = 0.0
+    sets: list[Any],
+    satellite: Satellite,
+    scenario: Any,
+    *,
+    satellite_given: bool,
+    offset_m: float = 0.0,
+    drag_from: str | None = None,
+    bad_sets: Sequence[Any] = (),
 ) -> BatchOrbits:
     """A batch of element sets as orbits in the sphere's heights [m] (``offset_m`` added), one row an object.
 
     Each object's sets are its history: its row starts from its latest set, the heights of
     the orbit flown, its inclination and, unless ``satellite`` is given, the drag fitted to
-    the decay between its sets; an object with one set has its B* calibrated to
-    ``scenario``'s air (in the sphere's heights). With ``satellite_given`` every row flies ``satellite``.
-    A row that cannot be decayed says why in its status, naming the set's line.
+    the decay between its sets; an object with one set has its drag read from it as ``drag_from``
+    says (`drag_from_elements`: by default its B* calibrated to ``scenario``'s air, in the sphere's
+    heights). With ``satellite_given`` every row flies ``satellite``. A row that cannot be decayed
+    says why in its status, naming the set's line; so does an object with a set that could not be
+    read (``bad_sets``, `orbit_env.analysis.elements.BadSet`): the batch goes on without it.
+    Each row says where its drag came from (``drag_parameter_source``, as JSON's for one lifetime).
     """
     from orbit_env.decay.curves import UniversalCurves
 
@@ -287,14 +302,28 @@ def element_set_orbits(
         histories.setdefault(s.catalogue_number, []).append(s)
     objects = [sorted(history, key=lambda s: s.epoch_days) for history in histories.values()]
     latest = [history[-1] for history in objects]
+    unread = {}  # catalogue number -> the first set of it that could not be read
+    for bad in bad_sets:
+        unread.setdefault(bad.catalogue_number, bad)
     rows = [{"name": s.name} for s in latest]
-    hp = np.array([s.flown_perigee_km for s in latest]) * 1e3 + offset_m
-    ha = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
-    inc = np.array([s.inclination_deg for s in latest])
-    c = np.full(len(latest), satellite.drag_parameter_m2_kg)
-    sigma = np.full(len(latest), np.nan)
-    status = ["ok"] * len(latest)
+    rows += [{"name": bad.name or number} for number, bad in unread.items() if number not in histories]
+    n = len(rows)
+    hp = np.full(n, np.nan)
+    ha = np.full(n, np.nan)
+    inc = np.full(n, np.nan)
+    epochs = np.full(n, np.nan)
+    hp[: len(latest)] = np.array([s.flown_perigee_km for s in latest]) * 1e3 + offset_m
+    ha[: len(latest)] = np.array([s.flown_apogee_km for s in latest]) * 1e3 + offset_m
+    inc[: len(latest)] = [s.inclination_deg for s in latest]
+    epochs[: len(latest)] = [s.epoch_days for s in latest]
+    c = np.full(n, satellite.drag_parameter_m2_kg)
+    sigma = np.full(n, np.nan)
+    status = ["ok"] * len(latest) + [f"{bad.message}" for number, bad in unread.items() if number not in histories]
+    source = [SOURCE_SATELLITE] * n
     for i, (s, history) in enumerate(zip(latest, objects, strict=True)):
+        if s.catalogue_number in unread:
+            status[i] = f"{unread[s.catalogue_number].message}; the object's other sets are not used"
+            continue
         if satellite_given:
             continue
         try:
@@ -303,20 +332,23 @@ def element_set_orbits(
                 with contextlib.suppress(NoHistoryToFit):  # else the latest set alone, as for an object of one set
                     fit = fit_history(history, scenario)
             if fit is not None:
-                c[i], sigma[i] = fit.drag_parameter_m2_kg, fit.sigma_ln
+                c[i], sigma[i], source[i] = fit.drag_parameter_m2_kg, fit.sigma_ln, SOURCE_HISTORY_FIT
             else:
-                calibration = calibrate(s, scenario)
-                if calibration is None:
-                    status[i] = f"line {s.line}: B* = {s.bstar_per_earth_radius:g} /ER gives no drag parameter"
-                else:
-                    c[i], sigma[i] = calibration.drag_parameter_m2_kg, ONE_SET_DRAG_SIGMA
+                c[i], source[i], _ = drag_from_elements(s, scenario, drag_from or DRAG_FROM_DEFAULT)
+                sigma[i] = ONE_SET_DRAG_SIGMA
+        except NoDragInSet as error:  # the satellite of the command line would fly every row: not offered
+            status[i] = f"line {s.line}: {error.value} gives no drag parameter"
         except ValueError as error:
             status[i] = f"line {s.line}: {error}"
-    for i in range(len(latest)):
+    for i in range(n):
         if status[i] == "ok":
             try:
                 UniversalCurves.check_domain(hp[i], ha[i])
             except ValueError:  # its message names metres above the sphere; the row shows km flown
                 status[i] = f"line {latest[i].line}: {_beyond_the_curves(latest[i], offset_m)}"
-    epochs = np.array([s.epoch_days for s in latest], dtype=np.float64)
+        if status[i] != "ok" or satellite_given:
+            source[i] = SOURCE_SATELLITE if satellite_given else ""
+        if status[i] != "ok" and not satellite_given:
+            c[i] = np.nan  # no drag was read: the row shows none
+        rows[i][DRAG_SOURCE_KEY] = source[i]
     return BatchOrbits(rows, hp, ha, c, inc, status, sigma, epochs)

@@ -27,6 +27,7 @@ import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 from orbit_env.checks import check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M
@@ -207,12 +208,23 @@ _SGP4_ERRORS = {
 }
 
 
-def parse_tle_text(lines: Iterable[str], source: str = "TLE") -> list[ElementSet]:
+class BadSet(NamedTuple):
+    """An element set that could not be read (`parse_tle_text` with ``bad``): where, whose, and why."""
+
+    line: int  # the file's line of its TLE line 1
+    catalogue_number: str  # as line 1 gives it (columns 3-7)
+    name: str | None  # its name line, if any
+    message: str  # what is wrong, naming the line (without the file's name)
+
+
+def parse_tle_text(lines: Iterable[str], source: str = "TLE", bad: list[BadSet] | None = None) -> list[ElementSet]:
     """Every element set of a text in CelesTrak's format: two-line sets, or three-line sets with a name line.
 
     Text as people paste it is read: lines may be indented, end in spaces, tabs or CRLF,
     and a set may have no name line. Blank lines are skipped; a name line is any line that
     does not start with ``1 `` or ``2 `` (a leading ``0 `` is dropped, as Space-Track writes it).
+    With ``bad`` (a list), a set whose lines are in place but do not read (a bad checksum, columns,
+    or elements SGP4 refuses) is appended to it and skipped, as a batch reads its file.
 
     Raises:
         ValueError: a malformed set (the message names the file's line and what is wrong), or no set at all.
@@ -235,24 +247,29 @@ def parse_tle_text(lines: Iterable[str], source: str = "TLE") -> list[ElementSet
         next_number, next_text = numbered[k + 1]
         if next_number != number + 1:
             raise ValueError(f"{source}, line {number + 1}: expected TLE line 2, found a blank line")
-        sets.append(parse_tle(text, next_text, name, source=source, first_line=number))
+        try:
+            sets.append(parse_tle(text, next_text, name, source=source, first_line=number))
+        except ValueError as error:
+            if bad is None:
+                raise
+            bad.append(BadSet(number, text[2:7].strip(), name, str(error).removeprefix(f"{source}, ")))
         k += 2
-    if not sets:
+    if not sets and not bad:
         raise ValueError(f"{source}: no element set found")
     return sets
 
 
-def read_tle(path: str | Path) -> list[ElementSet]:
-    """The element sets of a file (``-``: standard input); see `parse_tle_text`.
+def read_tle(path: str | Path, bad: list[BadSet] | None = None) -> list[ElementSet]:
+    """The element sets of a file (``-``: standard input); see `parse_tle_text` (and its ``bad``).
 
     Raises:
         ValueError: a malformed set, naming the line.
         OSError: the file cannot be read.
     """
     if str(path) == "-":
-        return parse_tle_text(sys.stdin.read().removeprefix("\ufeff").splitlines(), "<stdin>")
+        return parse_tle_text(sys.stdin.read().removeprefix("\ufeff").splitlines(), "<stdin>", bad)
     with open(path, encoding="utf-8-sig") as handle:  # a byte-order mark (Windows' editors) is no part of a name
-        return parse_tle_text(handle.read().splitlines(), str(path))
+        return parse_tle_text(handle.read().splitlines(), str(path), bad)
 
 
 def looks_like_tle(path: str | Path) -> bool:

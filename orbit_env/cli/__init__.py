@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from orbit_env import cache
 from orbit_env.checks import InputError
 from orbit_env.cli import agents, lifetime, paper, solar
-from orbit_env.cli.common import FLAGS, PROG, Parser, in_flags
+from orbit_env.cli.common import FLAGS, PROG, Parser, flag, in_flags
 
 __all__ = ["FLAGS", "PROG", "build_parser", "main"]
 
@@ -37,6 +37,15 @@ def build_parser() -> Parser:
     return parser
 
 
+def _in_files(error: Exception, args: object) -> str:
+    """An error's text; a file that cannot be read named with the flag it came from (``--tle x.tle: ...``)."""
+    if not (isinstance(error, OSError) and error.filename and error.strerror):
+        return str(error)
+    name = next((key for key, value in vars(args).items() if isinstance(value, str) and value == error.filename), None)
+    where = f"{flag(name)} " if name and name != "observations" else ""  # the positional OBS_CSV has no flag
+    return f"{where}{error.filename}: {error.strerror.lower()}"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     parser = build_parser()
@@ -46,7 +55,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
-        text = in_flags(error, args) if isinstance(error, InputError) else str(error)
+        text = in_flags(error, args) if isinstance(error, InputError) else _in_files(error, args)
         message = text.splitlines()[0] if text else type(error).__name__
         print(f"{PROG}: error: {message}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for it (a batch keeps its parts itself)
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130

@@ -10,6 +10,10 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, NoReturn
 
 from orbit_env.checks import InputError
@@ -51,6 +55,63 @@ def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
         writer = csv.DictWriter(handle, fieldnames=list(rows[0]), lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
+
+
+def check_output(
+    path: str, option: str, inputs: Sequence[tuple[str, str | None]] = (), *, force: bool | None = None
+) -> None:
+    """Refuse, before any computing, an output file that would replace an input, or cannot be written.
+
+    Args:
+        path: The file to write.
+        option: Its flag (``--out``), for the message.
+        inputs: (what, path) of the other files the command reads or writes, ``what`` as the message says it
+            (``"the input file of --tle"``); a path of None or ``-`` (stdin) is skipped.
+        force: None: an existing file is replaced (``--trajectory``, ``--plot``, as ``-o`` of most tools
+            does); False: an existing file is an error that names ``--force`` (a batch's ``--out``, whose
+            results are costly); True: replaced.
+
+    Raises:
+        ValueError: ``path`` is an input (also through a link), a directory, exists where ``force`` is
+            False, or its folder is missing or not writable.
+    """
+    out = Path(path)
+    for what, source in inputs:
+        if source in (None, "-"):
+            continue
+        same = out.exists() and Path(source).exists() and os.path.samefile(out, source)
+        if same or out.resolve() == Path(source).resolve():
+            raise ValueError(f"{option} {path} is {what}; write to another file")
+    if out.is_dir():
+        raise ValueError(f"{option} {path} is a directory; give a file name")
+    if out.exists() and force is False:
+        raise ValueError(f"{option} {path} exists; give --force to replace it, or another file name")
+    folder = out.parent
+    if not folder.is_dir():
+        raise ValueError(f"{option} {path}: the folder {folder} does not exist")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as error:
+        raise ValueError(f"{option} {path}: cannot write in {folder} ({error.strerror or error})") from None
+
+
+def check_figure(path: str, option: str, inputs: Sequence[tuple[str, str | None]] = ()) -> None:
+    """`check_output` of a figure, and its name's extension a format matplotlib writes (the format is the name's).
+
+    Raises:
+        ValueError: as `check_output`, or no extension, or one matplotlib does not write.
+    """
+    check_output(path, option, inputs)
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = sorted(FigureCanvasBase.get_supported_filetypes())
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in formats:
+        raise ValueError(
+            f"{option} {path}: the file name's extension gives the figure's format; allowed: "
+            f"{', '.join('.' + f for f in formats)}"
+        )
 
 
 def given(args: argparse.Namespace, name: str) -> bool:

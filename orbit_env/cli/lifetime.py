@@ -18,7 +18,7 @@ import numpy as np
 
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.air.msis import MSIS_VERSION_CHOICES
-from orbit_env.analysis.drag_source import drag_sigma
+from orbit_env.analysis.drag_source import SOURCE_DEFAULT, SOURCE_SATELLITE, DragSource, drag_sigma
 from orbit_env.analysis.lifetime import (
     METHODS,
     PAPER_DRAG_COEFFICIENT,
@@ -30,10 +30,22 @@ from orbit_env.analysis.lifetime import (
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import check_number
 from orbit_env.cli import orbit_inputs, uncertain_batch
-from orbit_env.cli.common import PROG, check_finite, flag, given, number, positive_int, write_csv
+from orbit_env.cli.common import (
+    PROG,
+    check_figure,
+    check_finite,
+    check_output,
+    flag,
+    given,
+    number,
+    positive_int,
+    write_csv,
+)
+from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS
 from orbit_env.decay.solar import (
     TableActivity,
     iso_date,
+    unix_days,
 )
 
 
@@ -49,7 +61,11 @@ def _scenario(args: argparse.Namespace) -> Scenario:
         raise ValueError("give either --rotating-atmosphere or --still-air, not both")
     # None: the model's own default (NRLMSIS co-rotates, the paper's and the exponential law are still).
     rotating = True if args.rotating_atmosphere else (False if args.still_air else None)
-    return Scenario(air, args.density_scale, rotating, args.chunk_days)
+    chunk_days = DEFAULT_CHUNK_DAYS if args.chunk_days is None else args.chunk_days
+    scenario = Scenario(air, args.density_scale, rotating, chunk_days)
+    if args.chunk_days is not None and scenario.epoch_days is None:
+        raise ValueError("--chunk-days is the time step of a dated decay: it goes with --epoch (or an element set's)")
+    return scenario
 
 
 def _satellite(args: argparse.Namespace) -> Satellite:
@@ -129,9 +145,36 @@ def _json(summary: dict[str, Any]) -> str:
     return json.dumps(summary, allow_nan=False)
 
 
+def _check_on_the_curves(perigee_km: float, apogee_km: float, offset_km: float) -> None:
+    """Refuse ``--uncertainty`` for an orbit off the universal curves, in the heights typed, before any decay.
+
+    Its samples decay on the curves (`orbit_env.analysis.uncertainty`); a thousand decays by the averaged
+    equations (a geostationary transfer orbit's) would take hours.
+    """
+    from orbit_env.decay.curves import CURVES_MAX_APOGEE_M, CURVES_MAX_PERIGEE_M
+
+    top, apogee_top = (h / 1e3 - offset_km for h in (CURVES_MAX_PERIGEE_M, CURVES_MAX_APOGEE_M))
+    if perigee_km > CURVES_MAX_PERIGEE_M / 1e3 or apogee_km > CURVES_MAX_APOGEE_M / 1e3:
+        raise ValueError(
+            f"--uncertainty samples decays on the universal curves (perigee up to {top:.1f} km, apogee up to "
+            f"{apogee_top:.1f} km here); this orbit ({perigee_km - offset_km:.1f} x {apogee_km - offset_km:.1f} km) "
+            "is above them: drop --uncertainty for its lifetime (and --rule's verdict) by the averaged equations"
+        )
+
+
+def _input_files(args: argparse.Namespace) -> list[tuple[str, str | None]]:
+    """The files a lifetime reads, with their flags: never to be written over."""
+    files = (("--tle", getattr(args, "tle", None)), ("--batch", args.batch), ("--solar-csv", args.solar_csv))
+    return [(f"the input file of {name}", path) for name, path in files]
+
+
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
     _check_inclination(args)
+    if args.trajectory and not args.batch:
+        check_output(args.trajectory, "--trajectory", _input_files(args))
+    if args.plot and not args.batch:
+        check_figure(args.plot, "--plot", [*_input_files(args), ("the --trajectory file", args.trajectory)])
     uncertain_batch.check_options(args)
     orbit = orbit_inputs.prepare(args)
     scenario = _scenario(args)
@@ -147,6 +190,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         raise ValueError("give --perigee and --apogee, --semi-major-axis-km and --eccentricity, --tle, or --batch")
     perigee_km, apogee_km = orbit.sphere_heights_km
     offset = orbit.offset_km
+    if args.uncertainty:
+        _check_on_the_curves(perigee_km, apogee_km, offset)
     air = scenario.in_sphere_heights(orbit.reference, args.inclination)
     result = lifetime(
         perigee_km, apogee_km, satellite=satellite, scenario=air, method=args.method, inclination_deg=args.inclination
@@ -224,11 +269,23 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     return 0
 
 
+def _batch_epochs(args: argparse.Namespace, orbits: Any, scenario: Scenario) -> Any:
+    """Each row's start [unix days] in a dated batch (its object's latest set, or --epoch), None undated.
+
+    Given, the results gain the ``epoch`` and ``reentry_date`` columns a dated lifetime prints.
+    """
+    if getattr(args, "rows_own_epochs", False):
+        return orbits.epoch_days
+    if scenario.epoch_days is not None:
+        return np.full(len(orbits.rows), scenario.epoch_days)
+    return None
+
+
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
     from concurrent.futures.process import BrokenProcessPool
 
     from orbit_env.analysis.catalogue import batch_lifetimes
-    from orbit_env.analysis.catalogue_io import check_output, write_records
+    from orbit_env.analysis.catalogue_io import write_records
     from orbit_env.analysis.catalogue_parts import parts_folder
 
     if not args.out:
@@ -240,7 +297,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             raise ValueError(f"{flag(name)} applies to a single lifetime, not to --batch")
     if args.method is not None:
         raise ValueError("--batch always uses the universal curves; do not give --method")
-    check_output(args.out, args.batch, force=args.force)
+    check_output(args.out, "--out", _input_files(args), force=args.force)
     start = time.perf_counter()
     orbits = orbit_inputs.read_orbits(args, satellite, scenario)
     air = scenario.in_sphere_heights(args.height_reference, args.inclination)
@@ -267,7 +324,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             air,
             rule_years=args.rule,
             progress=not args.no_progress,
-            epoch_days=orbits.epoch_days if getattr(args, "rows_own_epochs", False) else None,
+            epoch_days=_batch_epochs(args, orbits, scenario),
         )
         write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
         rows, ok = summary.rows, summary.ok
@@ -301,6 +358,10 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
         args.inclination = 0.0
     observations = read_observations(args.observations)
     solar_given = any(given(args, name) for name in ("f107", "f107a", "ap", "solar_csv", "solar_cycle"))
+    if observations.axis == "date" and args.epoch is not None and not solar_given:
+        # The first observation's date, as typed (a day, no time): the air from that observation's moment.
+        if math.floor(unix_days(args.epoch)) == math.floor(float(observations.days[0])):
+            args.epoch = None
     if observations.axis == "date" and args.epoch is None and not solar_given:
         # Dated observations: the air of their days, the real Sun from the first (as a TLE's epoch does).
         if args.atmosphere is None:
@@ -323,12 +384,17 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     )
     if reentry is not None and scenario.epoch_days is not None:
         _warn_solar_table(scenario, scenario.epoch_days + reentry - float(observations.days[0]))
+    # The scale belongs to the drag parameter it was fitted with: both are said.
+    drag = DragSource(satellite, SOURCE_SATELLITE if orbit_inputs.satellite_inputs(args).given else SOURCE_DEFAULT)
     if args.json:
-        print(_json({**fit.to_dict(), "atmosphere": _atmosphere(args, scenario)}))
+        summary = {**fit.to_dict(), "atmosphere": _atmosphere(args, scenario)}
+        summary.update(drag_parameter_m2_kg=satellite.drag_parameter_m2_kg, drag_parameter_source=drag.source)
+        print(_json(summary))
         return 0
     check_finite(fit.to_dict(), "the fit")
     low68, high68 = fit.interval(0.68)
     low95, high95 = fit.interval(0.95)
+    print(orbit_inputs.satellite_line(drag))
     print(f"atmosphere         {_atmosphere(args, scenario)}")
     print(f"data               {fit.description}")
     print(f"density scale      {fit.scale:.4g} (68%: {low68:.4g} to {high68:.4g}; 95%: {low95:.4g} to {high95:.4g})")
@@ -339,7 +405,8 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
 
 def _add_satellite_options(parser: argparse.ArgumentParser, shapes: bool = False) -> None:
     group = parser.add_argument_group("satellite")
-    group.add_argument("--cx", type=number, help="drag coefficient (default 2.0; with --tle: from B*)")
+    from_sets = "; with --tle and no satellite given, the drag comes from the element sets" if shapes else ""
+    group.add_argument("--cx", type=number, help=f"drag coefficient (default 2.0{from_sets})")
     group.add_argument("--mass", type=number, metavar="KG", help="mass [kg] (with --area; default the paper's 10 kg)")
     group.add_argument("--area", type=number, metavar="M2", help="reference area [m^2] (default 0.5 m sphere)")
     group.add_argument("--mass-per-area", type=number, metavar="KG_M2", help="transverse load G/F [kg/m^2]")
@@ -382,7 +449,12 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
         "or the 57 h before, take NRLMSIS's storm-time mode with the record's 3-hourly ap)",
     )
     group.add_argument("--node-local-time", type=number, metavar="HOURS", help="msis: Sun-synchronous node local time")
-    group.add_argument("--chunk-days", type=number, default=20.0, help="msis with --epoch: time step (default 20)")
+    group.add_argument(
+        "--chunk-days",
+        type=number,
+        metavar="DAYS",
+        help=f"msis with --epoch: time step [days] (default {DEFAULT_CHUNK_DAYS:g})",
+    )
     group.add_argument(
         "--rotating-atmosphere",
         action="store_true",

@@ -155,13 +155,16 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         from orbit_env.analysis.elements import looks_like_tle, read_tle
 
         args.batch_element_sets = looks_like_tle(args.batch)
-        args.batch_sets = read_tle(args.batch) if args.batch_element_sets else None  # read once (`read_orbits`)
+        # Read once (`read_orbits`); a set that does not read is its object's row's status, not the batch's end.
+        args.batch_bad_sets = []
+        args.batch_sets = read_tle(args.batch, bad=args.batch_bad_sets) if args.batch_element_sets else None
         dated = "epoch" in air_model(args.atmosphere or DATED_AIR).options
         # A batch of element sets: each object from its own latest set's epoch, as --tle starts from its set's.
-        if args.batch_sets is not None and args.epoch is None and dated:
+        if args.batch_sets and args.epoch is None and dated:
             first = min(args.batch_sets, key=lambda s: s.epoch_days)
             args.epoch = first.epoch_iso.rstrip("Z")  # dates the air; each row moves it to its own
             args.rows_own_epochs = True
+    _check_element_set_options(args, tle is not None or getattr(args, "batch_sets", None) is not None, elements)
     if args.inclination is None:
         args.inclination = 0.0
     if args.atmosphere is None:
@@ -179,6 +182,31 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         _check_flown(orbit, "the element set" if tle is not None else "--semi-major-axis-km/--eccentricity")
         return orbit
     return OrbitInput(perigee, apogee, reference)
+
+
+def _check_element_set_options(args: argparse.Namespace, from_sets: bool, latest: Any) -> None:
+    """Options that mean nothing, or something else than they say, with (or without) element sets: refused.
+
+    ``--drag-from`` reads element sets; a drag calibrated or fitted to the air from them absorbs any
+    ``--density-scale`` (the same lifetime whatever the scale); a ``--tle`` set's epoch is the decay's start.
+    """
+    drag_from = getattr(args, "drag_from", None)
+    if drag_from is not None and not from_sets:
+        raise ValueError(
+            "--drag-from says what an element set's drag is read from: it goes with --tle (or --batch sets)"
+        )
+    own_drag = not satellite_inputs(args).given and drag_from != "bstar-raw"
+    if from_sets and own_drag and getattr(args, "density_scale", 1.0) != 1.0:
+        raise ValueError(
+            "--density-scale changes nothing when the drag is calibrated to the air from element sets (the "
+            "calibration absorbs the scale); to fly a fitted scale, give the satellite: --mass and --area (or --shape)"
+        )
+    tle_epoch = None if latest is None or getattr(args, "tle", None) is None else latest.epoch_iso.rstrip("Z")
+    if tle_epoch is not None and args.epoch is not None and args.epoch != tle_epoch:
+        raise ValueError(
+            f"--epoch {args.epoch}: the decay starts at the element set's epoch ({latest.epoch_iso}), where its orbit "
+            "was measured; drop --epoch (to fly that orbit from another date, give its heights with --perigee/--apogee)"
+        )
 
 
 def _check_flown(orbit: OrbitInput, given: str) -> None:
@@ -291,10 +319,13 @@ def satellite_line(drag: DragSource) -> str:
         )
     if "drag_fit" in report:
         fit = report["drag_fit"]
+        residual = (
+            "two sets, no residual" if fit["residual_km"] is None else f"residual {fit['residual_km'] * 1e3:.0f} m"
+        )
         return (
             f"satellite          c_x A/m = {c:.4g} m^2/kg fitted to the decay between {fit['sets']} element sets over "
-            f"{fit['span_days']:.1f} days (residual {fit['residual_km'] * 1e3:.0f} m, c within "
-            f"{100 * fit['sigma_ln']:.1f}% at 1 sigma); from the latest set"
+            f"{fit['span_days']:.1f} days ({residual}, c within {100 * fit['sigma_ln']:.1f}% at 1 sigma); "
+            "from the latest set"
         )
     if "sgp4_to_air_density_ratio" in report:
         what = "B*" if source == SOURCE_BSTAR_CALIBRATED else "ndot"
@@ -360,6 +391,8 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
         scenario.in_sphere_heights("equatorial", float(args.inclination or 0.0)),
         satellite_given=satellite_inputs(args).given,
         offset_m=offset_m,
+        drag_from=getattr(args, "drag_from", None),
+        bad_sets=args.batch_bad_sets,
     )
 
 
@@ -387,8 +420,21 @@ def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
         "and with --rule the probability of compliance; with --batch, every row's (seeded by the row), in "
         "chunks over --workers processes, resumed from OUT.parts/ by the same command",
     )
-    group.add_argument("--samples", type=positive_int, default=1000, help="with --uncertainty: samples (default 1000)")
-    group.add_argument("--seed", type=int, default=0, help="with --uncertainty: random seed (default 0)")
+    group.add_argument("--samples", type=positive_int, help=f"with --uncertainty: samples (default {DEFAULT_SAMPLES})")
+    group.add_argument("--seed", type=int, help="with --uncertainty: random seed (default 0)")
+
+
+#: ``--samples`` when not given.
+DEFAULT_SAMPLES = 1000
+
+
+def resolve_uncertainty_options(args: argparse.Namespace) -> None:
+    """Refuse ``--samples``/``--seed`` without ``--uncertainty`` (they would do nothing); fill in their defaults."""
+    for name in ("samples", "seed"):
+        if getattr(args, name) is not None and not args.uncertainty:
+            raise ValueError(f"--{name} goes with --uncertainty")
+    args.samples = DEFAULT_SAMPLES if args.samples is None else args.samples
+    args.seed = 0 if args.seed is None else args.seed
 
 
 def uncertainty(

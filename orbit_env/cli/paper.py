@@ -8,6 +8,8 @@ import json
 import sys
 from typing import Any
 
+from orbit_env.cli.common import check_figure
+
 
 def _cmd_table2(args: argparse.Namespace) -> int:
     from orbit_env.paper.table2 import compare_table2
@@ -50,6 +52,7 @@ def _cmd_table2(args: argparse.Namespace) -> int:
 def _cmd_fig2(args: argparse.Namespace) -> int:
     from orbit_env.paper.figures import plot_fig2
 
+    check_figure(args.out, "--out")
     out = plot_fig2(args.out)
     print(f"wrote {out}")
     return 0

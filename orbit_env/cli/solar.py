@@ -38,7 +38,9 @@ def _cmd_show(args: argparse.Namespace) -> int:
 def add_parsers(sub: Any) -> None:
     """The ``solar`` command and its ``show`` and ``update`` subcommands."""
     solar = sub.add_parser("solar", help="the observed and forecast solar activity NRLMSIS follows (show, update)")
-    actions = solar.add_subparsers(dest="solar_command", required=True, parser_class=type(solar))
+    actions = solar.add_subparsers(
+        dest="solar_command", metavar="{show,update}", required=True, parser_class=type(solar)
+    )
     show = actions.add_parser("show", help="which space-weather record is in use, and its dates")
     show.set_defaults(func=_cmd_show)
     update = actions.add_parser(

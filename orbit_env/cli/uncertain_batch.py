@@ -24,11 +24,13 @@ from orbit_env.analysis.scenario import Scenario
 from orbit_env.analysis.uncertainty import check_samples
 from orbit_env.cache import source_digest
 from orbit_env.checks import check_number
-from orbit_env.cli.orbit_inputs import records_in_reference
+from orbit_env.cli.orbit_inputs import records_in_reference, resolve_uncertainty_options
 
 #: Options that change no result (where the results go, how they are shown, where they run), and the batch
 #: file's element sets as `orbit_inputs.prepare` read them (the file's bytes are in the fingerprint).
-NOT_IN_FINGERPRINT = frozenset({"out", "force", "no_progress", "workers", "address", "no_cache", "func", "batch_sets"})
+NOT_IN_FINGERPRINT = frozenset(
+    {"out", "force", "no_progress", "workers", "address", "no_cache", "func", "batch_sets", "batch_bad_sets"}
+)
 
 
 @dataclass(frozen=True)
@@ -64,6 +66,7 @@ def check_options(args: argparse.Namespace) -> None:
     Raises:
         ValueError: as said.
     """
+    resolve_uncertainty_options(args)
     if args.workers is not None and not args.uncertainty:
         raise ValueError("--workers goes with --uncertainty (its solar nodes, or with --batch its chunks of rows)")
     if args.address is not None and not (args.batch and args.uncertainty):

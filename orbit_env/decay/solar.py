@@ -54,17 +54,26 @@ SOLAR_CYCLE_DAYS = 11.0 * 365.25
 def unix_days(date: str | _dt.date | np.datetime64) -> float:
     """Days since 1970-01-01 of an ISO date (``YYYY-MM-DD``, ``YYYY-MM`` = the 15th, or with a time).
 
+    A time may carry its zone (``Z``, ``+02:00``), as element sets' epochs are printed: it is
+    converted to UTC; a time without one is UTC.
+
     Raises:
         ValueError: the date cannot be read.
     """
     text = str(date).strip()
+    if len(text) == 7 and text[4] == "-":
+        text += "-15"  # a month: its middle (monthly tables' values are the month's)
     try:
-        if len(text) == 7 and text[4] == "-":
-            value = np.datetime64(text + "-15", "s")
-        else:
-            value = np.datetime64(text, "s")
+        if "T" in text and (text.endswith(("Z", "z")) or "+" in text[10:] or "-" in text[10:]):
+            moment = _dt.datetime.fromisoformat(text)
+            seconds = (moment - _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)).total_seconds()
+            return seconds / 86400.0
+        value = np.datetime64(text, "s")
     except ValueError as error:
-        raise ValueError(f"cannot read the date {text!r}; expected YYYY-MM-DD or YYYY-MM") from error
+        raise ValueError(
+            f"cannot read the date {text!r}; expected YYYY-MM-DD, YYYY-MM or YYYY-MM-DDTHH:MM[:SS] (UTC, or with "
+            "its zone: Z, +HH:MM)"
+        ) from error
     return float(value.astype(np.int64)) / 86400.0
 
 
