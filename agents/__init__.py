@@ -10,3 +10,7 @@ EVAL_SEED = 12345
 #: Default number of episodes: with 1000 the paired difference of two good policies has a
 #: standard error of about 0.1 day (0.3 with 200), below the gaps between them.
 EVAL_EPISODES = 1000
+#: Seed of the validation missions: training's validation score (`orbit_env.agents.train`) and, on the solar
+#: task, the missions the operators' rules are tuned on (`orbit_env.agents.solar`): one seed, so that the
+#: shipped solar recipe is validated on the missions its yardsticks were tuned on.
+VALIDATION_SEED = 777

@@ -148,6 +148,9 @@ def curves(
     for algo in algos:
         if algo not in CURVE_ALGOS:
             raise ValueError(f"unknown algorithm {algo!r}; allowed: {', '.join(CURVE_ALGOS)}")
+    repeated = sorted({algo for algo in algos if list(algos).count(algo) > 1})
+    if repeated:
+        raise ValueError(f"algorithms {', '.join(repeated)} given twice: each is one curve of seeds")
     if env_id not in RECIPES:
         raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join(RECIPES)}")
     if min(seeds, timesteps, every, workers) < 1 or (episodes is not None and episodes < 1):

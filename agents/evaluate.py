@@ -349,7 +349,8 @@ def load_model(
     ``model_path`` None: the shipped model of ``env_id`` (None if there is none).
     The file must exist and load; its observation and action spaces must be the
     environment's; a model that records another environment (``orbit-env train``
-    records it) gets a warning through ``warn``, as does one that records none.
+    records it) gets a warning through ``warn``, as does one that records none, and one
+    trained with settings of its env (a TOML's ``[env]`` table, its split aside).
 
     The model is loaded to act, not to train: its optimizer is `ActingOnly`
     (a torch optimizer would import torch's compiler, 1.4 s of CPU).
@@ -406,12 +407,20 @@ def load_model(
             raise ValueError(
                 f"{path} acts in the {what} space {_space_text(theirs)}, but {env_id} has {_space_text(mine)}"
             )
-    trained_on = (getattr(model, "orbit_env", None) or {}).get("env_id")
+    recorded = getattr(model, "orbit_env", None) or {}
+    trained_on = recorded.get("env_id")
+    # The split is the evaluation's to choose (a solar agent trains on one, is scored on the other).
+    settings = {k: v for k, v in (recorded.get("env") or {}).items() if k != "solar_split"}
     if warn is not None:
         if trained_on is None:
             warn(f"{path} does not record the environment it was trained on")
         elif trained_on != env_id:
             warn(f"{path} was trained on {trained_on}, not {env_id}")
+        if settings:
+            warn(
+                f"{path} was trained with the env settings {settings}; it is scored here on {env_id} as registered, "
+                "the task the yardsticks solve"
+            )
     return algorithm, model
 
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.agents import VALIDATION_SEED
 from orbit_env.agents.evaluate import Episodes, predicted_actions
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.envs import solar_task
@@ -36,8 +37,9 @@ from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
 
 FloatArray = NDArray[np.float64]
 
-#: Seed of the tuning missions on the train split (the evaluation's is `orbit_env.agents.evaluate.EVAL_SEED`).
-TUNE_SEED = 777
+#: Seed of the tuning missions on the train split, training's validation seed (the evaluation's is
+#: `orbit_env.agents.EVAL_SEED`).
+TUNE_SEED = VALIDATION_SEED
 #: Missions the thresholds are tuned on.
 TUNE_EPISODES = 300
 #: Perigee thresholds tried [km] and delta-v reserves kept for the disposal [m/s].

@@ -300,7 +300,8 @@ def sweep(
     solving the references' DPs (`capture_references`).
 
     Raises:
-        ValueError: an unknown env or algorithm, one that does not fit the action space, counts below 1.
+        ValueError: an unknown env or algorithm, one that does not fit the action space or is given twice, counts
+            below 1, or an OUT folder that holds a sweep of other settings.
         ImportError: Ray is not installed (the ``cluster`` extra).
     """
     import gymnasium
@@ -327,10 +328,30 @@ def sweep(
         from ray import tune
     except ImportError as error:
         raise ImportError("orbit-env sweep runs on Ray Tune: pip install 'orbit-env[cluster]'") from error
+    repeated = sorted({algo for algo in algos if list(algos).count(algo) > 1})
+    if repeated:
+        raise ValueError(f"algorithms {', '.join(repeated)} given twice: each is one row of seeds")
     say = progress or (lambda text: None)
     eval_seed = EVAL_SEED if eval_seed is None else eval_seed
     out = Path(out_dir).resolve()
     out.mkdir(parents=True, exist_ok=True)
+    # A folder resumes its own sweep only: Ray restores the trials it was given, whatever is asked now.
+    settings = {
+        "env": env_id,
+        "algos": list(algos),
+        "seeds": int(seeds),
+        "timesteps": int(timesteps),
+        "episodes": int(episodes),
+        "eval_seed": int(eval_seed),
+        "dp": bool(include_dp),
+    }
+    settings_path = out / "settings.json"
+    if settings_path.is_file():
+        kept = json.loads(settings_path.read_text())
+        if kept != settings:
+            raise ValueError(f"{out} holds a sweep of other settings ({kept}); give another --out to run this one")
+    else:
+        settings_path.write_text(json.dumps(settings) + "\n")
     # The references of the capture, once for all trials (the DP's solve is the heavy part).
     references_path = out / "references.json"
     if references_path.is_file():

@@ -27,6 +27,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
 
+from orbit_env.agents import VALIDATION_SEED  # the evaluation callback's (training uses the config's seed)
 from orbit_env.agents.shaping import SHAPINGS
 
 #: The hyperparameter file of the shipped model.
@@ -94,8 +95,6 @@ POLICY_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {
 NORMALIZE_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {"reward": (bool, False)}
 #: The policy network's activations by name.
 ACTIVATIONS = ("tanh", "relu", "elu", "gelu", "leaky_relu")
-#: Seed of the evaluation callback's episodes (training uses the config's seed, ``orbit-env evaluate`` 12345).
-VALIDATION_SEED = 777
 #: PPO's constructor arguments a config may not set: the command sets them.
 _PPO_RESERVED = ("self", "policy", "env", "tensorboard_log", "policy_kwargs", "verbose", "seed", "device")
 
@@ -295,8 +294,10 @@ class BestModelCallback(BaseCallback):
         episodes: Episodes per evaluation.
         seed: Seed of the episodes.
         save_dir: Folder of ``best_model.zip`` and ``evaluations.json``.
-        resume: Continue the scores of ``save_dir/evaluations.json``: a new model is
-            saved only if it beats them.
+        resume: The timesteps of the checkpoint a resumed run continues from: the scores of
+            ``save_dir/evaluations.json`` up to it are continued (a new model is saved only if it
+            beats them); those after it were of the run being replaced and are dropped, and if
+            one of them made ``best_model.zip``, that file is kept as ``best_model_replaced.zip``.
     """
 
     def __init__(
@@ -307,7 +308,7 @@ class BestModelCallback(BaseCallback):
         episodes: int,
         seed: int,
         save_dir: str | Path,
-        resume: bool = False,
+        resume: int | None = None,
     ) -> None:
         super().__init__(verbose=0)
         self.env_id = env_id
@@ -318,10 +319,15 @@ class BestModelCallback(BaseCallback):
         self.save_dir = Path(save_dir)
         self.best_mean = -float("inf")
         self.evaluations: list[dict[str, float]] = []
-        if resume and (self.save_dir / "evaluations.json").is_file():
-            # A resumed run's best model stays the best unless beaten.
-            self.evaluations = json.loads((self.save_dir / "evaluations.json").read_text())
+        if resume is not None and (self.save_dir / "evaluations.json").is_file():
+            # A resumed run's best model stays the best unless beaten; the scores after its checkpoint are
+            # of the branch it replaces (a checkpoint older than the last score: they would appear twice).
+            scores = json.loads((self.save_dir / "evaluations.json").read_text())
+            self.evaluations = [e for e in scores if e["timesteps"] <= resume]
             self.best_mean = max((e["mean_return"] for e in self.evaluations), default=-float("inf"))
+            replaced = max((e["mean_return"] for e in scores if e["timesteps"] > resume), default=-float("inf"))
+            if replaced > self.best_mean and self.best_model_path.is_file():
+                self.best_model_path.replace(self.save_dir / "best_model_replaced.zip")
 
     @property
     def best_model_path(self) -> Path:
@@ -521,7 +527,7 @@ def train(
             config["eval_episodes"],
             VALIDATION_SEED,
             out,
-            resume=checkpoint is not None,
+            resume=None if checkpoint is None else int(model.num_timesteps),
         )
         callbacks.append(best)
     callbacks.extend(extra_callbacks)

@@ -7,7 +7,7 @@ import json
 import sys
 from typing import Any
 
-from orbit_env.cli.common import PROG, positive_int
+from orbit_env.cli.common import PROG, check_figure, positive_int
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
@@ -51,6 +51,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     from orbit_env.envs import SOLAR_ENV_ID
 
+    _solar_options(args, args.env == SOLAR_ENV_ID)
+    if args.plot and not args.certify:
+        check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
     if args.certify:
         given = [flag for flag, value in (("--model", args.model), ("--plot", args.plot)) if value]
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
@@ -87,6 +90,20 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _solar_options(args: argparse.Namespace, solar: bool) -> None:
+    """Refuse the options of one kind of env given for the other (they would do nothing); fill in the defaults."""
+    only_solar = ("solar_split", "disposal_years", "workers")
+    given = [f"--{name.replace('_', '-')}" for name in only_solar if getattr(args, name) is not None]
+    if not solar and given:
+        verb = "applies" if len(given) == 1 else "apply"
+        raise ValueError(f"{', '.join(given)} {verb} to OrbitRaisingSolar-v0 only, not to {args.env}")
+    if solar and args.dp_lookahead is not None:
+        raise ValueError("--dp-lookahead applies to the known-density envs; the solar DP's policy looks a month ahead")
+    args.solar_split = "test" if args.solar_split is None else args.solar_split
+    args.disposal_years = 5.0 if args.disposal_years is None else args.disposal_years
+    args.dp_lookahead = 1 if args.dp_lookahead is None else args.dp_lookahead
+
+
 def _yardsticks(args: argparse.Namespace, *, lookahead: bool = True) -> dict[str, Any]:
     """What made the rows of a JSON result that its reader cannot see: which DP policy, which model."""
     dp = {"lookahead": args.dp_lookahead, "rollout": args.dp_rollout} if lookahead else {"rollout": args.dp_rollout}
@@ -117,13 +134,15 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         plot_returns(results, args.env, args.plot)
     table = summarize(results)
     report = solar_report(evaluation)
-    # Episode by episode: the learned agent and the optimum against the best operators' rule,
-    # then the learned agent against the optimum.
+    # Episode by episode: the optimum against the best operators' rule (the task's headroom), the learned
+    # agent against that rule and against the optimum. The JSON keys mean what they mean for every env:
+    # paired_difference the learned agent less the best rule, paired_to_dp the learned agent less the DP.
     best_rule = max(SOLAR_HAND_CODED, key=lambda name: results[name].returns.mean())
+    agent = next(iter(learned), None)
     pairs = {
-        "paired_difference": paired_difference(results, name="dp", baseline=best_rule),
-        **{f"paired_{name}": paired_difference(results, name=name, baseline=best_rule) for name in learned},
-        **{f"paired_{name}_to_dp": paired_difference(results, name=name, baseline="dp") for name in learned},
+        "paired_dp": paired_difference(results, name="dp", baseline=best_rule),
+        "paired_difference": None if agent is None else paired_difference(results, name=agent, baseline=best_rule),
+        "paired_to_dp": None if agent is None else paired_difference(results, name=agent, baseline="dp"),
     }
     paired = {key: pair for key, pair in pairs.items() if pair is not None}
     if args.json:
@@ -211,6 +230,8 @@ def _cmd_curves(args: argparse.Namespace) -> int:
     from orbit_env.agents.curves import curves, format_curves, plot_curves
 
     algos = [a.strip() for a in args.algos.split(",") if a.strip()]
+    if args.plot:
+        check_figure(args.plot, "--plot")
     result = curves(
         args.env,
         algos,
@@ -266,8 +287,8 @@ def add_parsers(sub: Any) -> None:
         "--dp-lookahead",
         type=int,
         choices=(1, 2),
-        default=1,
-        help="steps the DP policy takes exactly before reading its grid (default 1; 2 is closer to the optimum)",
+        help="steps the DP policy takes exactly before reading its grid (default 1; 2 is closer to the optimum; "
+        "not OrbitRaisingSolar-v0, whose DP policy looks one month ahead)",
     )
     ev.add_argument(
         "--dp-rollout",
@@ -283,13 +304,11 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--solar-split",
         choices=("train", "test"),
-        default="test",
         help="OrbitRaisingSolar-v0: the record's split the missions are drawn from (default test: cycles 24-25)",
     )
     ev.add_argument(
         "--disposal-years",
         type=float,
-        default=5.0,
         metavar="Y",
         help="OrbitRaisingSolar-v0: the disposal rule, re-entry within Y years of the mission's end (default 5)",
     )

@@ -23,7 +23,7 @@ same quantity as the N = u / 2 pi of Eq. (3.10). The state is the flat vector
 (x, y, z, vx, vy, vz, sigma).
 
 The averaged model predicts N = nu / (g c) revolutions and t = W / (g c) seconds
-(`orbit_env.decay.integrate_averaged`); ``tests/decay/test_direct.py`` compares
+(`orbit_env.decay.averaged.integrate_averaged`); ``tests/decay/test_direct.py`` compares
 the two and ``docs/validation.md`` lists the numbers.
 """
 

@@ -22,6 +22,7 @@ from orbit_env.envs import ENDED_WARNING, solar_task
 from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.solar_task import SOLAR_CONFIG, SOLAR_OBS_NAMES, SolarMission, SolarTask
 from orbit_env.envs.state import ROW, BatchState
+from orbit_env.envs.vector import batch_seed
 
 FloatArray = NDArray[np.float64]
 
@@ -183,6 +184,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     @property
     def start_options(self) -> dict[str, float]:
         """The reset options that give this episode's start back exactly (a new dict)."""
+        if self._state is None:
+            raise RuntimeError("the environment has no state before reset()")
         return {k: float(v[0]) for k, v in self._start.items()}
 
     def reset(
@@ -319,11 +322,14 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         return self._state
 
     def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
-        """Start ``num_envs`` new missions (``options`` as the single environment's, numbers or arrays)."""
+        """Start ``num_envs`` new missions (``options`` as the single environment's, numbers or arrays).
+
+        A list of seeds, one per env (Gymnasium's form), seeds the one generator (`batch_seed`).
+        """
         if seed is not None:
-            self._np_random, self._np_random_seed = gym.utils.seeding.np_random(seed)
+            self._np_random, self._np_random_seed = gym.utils.seeding.np_random(batch_seed(seed, self.num_envs))
         self._state = solar_task.start(self.task, self.np_random, self.num_envs, options)
         self._needs_reset[:] = False
         self._dv_used[:] = 0.0

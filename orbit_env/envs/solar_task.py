@@ -263,19 +263,31 @@ def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping
     day = rng.integers(first, last + 1, size).astype(np.float64)
     low_km, high_km = config.start_perigee_km
     perigee_km = rng.uniform(low_km, high_km, size)
-    apogee_km = perigee_km + rng.uniform(0.0, mission.start_span_km, size)
+    span_km = rng.uniform(0.0, mission.start_span_km, size)
+    window = (
+        f"({iso_date(task.clock.start_days + first)} to {iso_date(task.clock.start_days + last)}, "
+        f"the {mission.solar_split} split)"
+    )
     if "start_date" in options:
-        options["start_day"] = np.vectorize(lambda d: task.clock.day_of(unix_days(str(d))))(options.pop("start_date"))
+        given = options.pop("start_date")
+        options["start_day"] = np.vectorize(lambda d: task.clock.day_of(unix_days(str(d))))(given)
+        named = f"start_date={given!r}", f"dates {window}"
+    else:
+        named = f"start_day={options.get('start_day')!r}", f"whole days in [{first}, {last}] {window}"
     if "start_day" in options:
         day = np.broadcast_to(np.asarray(options["start_day"], dtype=np.float64), (size,)).copy()
         if not np.all((day == np.round(day)) & (day >= first) & (day <= last)):
-            raise ValueError(
-                f"start_day={options['start_day']!r} is invalid; allowed: whole days in [{first}, {last}] "
-                f"({iso_date(task.clock.start_days + first)} to {iso_date(task.clock.start_days + last)}, "
-                f"the {mission.solar_split} split)"
-            )
-    perigee_km = np.broadcast_to(np.asarray(options.get("perigee_km", perigee_km), dtype=np.float64), (size,))
-    apogee_km = np.broadcast_to(np.asarray(options.get("apogee_km", apogee_km), dtype=np.float64), (size,))
+            raise ValueError(f"{named[0]} is invalid; allowed: {named[1]}")
+    # A pinned height carries the other with it: the apogee up to start_span_km above the perigee.
+    if "perigee_km" in options and "apogee_km" not in options:
+        perigee_km = np.broadcast_to(np.asarray(options["perigee_km"], dtype=np.float64), (size,))
+        apogee_km = perigee_km + span_km
+    elif "apogee_km" in options and "perigee_km" not in options:
+        apogee_km = np.broadcast_to(np.asarray(options["apogee_km"], dtype=np.float64), (size,))
+        perigee_km = apogee_km - span_km
+    else:
+        pinned = (options.get("perigee_km", perigee_km), options.get("apogee_km", perigee_km + span_km))
+        perigee_km, apogee_km = (np.broadcast_to(np.asarray(h, dtype=np.float64), (size,)) for h in pinned)
     if "perigee_km" in options or "apogee_km" in options:  # drawn ones are in the domain: the config is checked
         task.curves.check_domain_km(perigee_km, apogee_km)
     state = BatchState(size)

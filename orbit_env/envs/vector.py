@@ -38,7 +38,33 @@ FloatArray = NDArray[np.float64]
 
 #: The keys of ``info`` that describe each episode so far (with their ``_key`` masks).
 OUTCOME_KEYS = ("reentered", "days_in_orbit", "dv_used_m_s")
+
+
 #: The keywords of the vector environment besides the config's and the density's fields.
+def batch_seed(seed: Any, num_envs: int) -> int | None:
+    """The seed of a batched env's one generator from ``reset(seed=...)``: None, an int, or one int per env.
+
+    Gymnasium's vector API takes a list of ``num_envs`` seeds, one per sub-environment; a batched env
+    draws every mission from one generator, seeded here from the whole list (`numpy.random.SeedSequence`):
+    the same list gives the same missions, but not those of single envs seeded with each element.
+
+    Raises:
+        ValueError: anything else (a list of another length, or not of whole numbers >= 0).
+    """
+    if seed is None or (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool)):
+        return seed
+    values = list(seed) if isinstance(seed, (list, tuple, np.ndarray)) else None
+    if (
+        values is None
+        or len(values) != num_envs
+        or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 0 for v in values)
+    ):
+        raise ValueError(
+            f"seed={seed!r} is invalid; allowed: None, an integer, or a list of {num_envs} integers >= 0 (one per env)"
+        )
+    return int(np.random.SeedSequence([int(v) for v in values]).generate_state(1, np.uint64)[0])
+
+
 _ENV_KEYWORDS = ("num_envs", "config", "continuous", "density", "max_episode_steps", "render_mode", "autoreset_mode")
 
 
@@ -163,9 +189,9 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         return self._state
 
     def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[NDArray[np.float32], dict[str, Any]]:
-        """Start new missions (options as the single env's, per env).
+        """Start new missions (options as the single env's, per env; a list of seeds: `batch_seed`).
 
         ``options["reset_mask"]``, a boolean array of shape (num_envs,) as in
         Gymnasium's ``SyncVectorEnv``, restarts only the masked sub-environments;
@@ -173,7 +199,7 @@ class OrbitRaisingVectorEnv(TaskView, VectorEnv):
         The other options then apply to the masked ones (arrays of shape
         (num_envs,) are read at the masked places).
         """
-        super().reset(seed=seed)
+        super().reset(seed=batch_seed(seed, self.num_envs))
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
         if mask is None or seed is not None:

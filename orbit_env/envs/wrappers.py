@@ -7,7 +7,8 @@ where a burn no longer pays (a day to a few weeks) all lie in 0 to 0.08. The log
 features are ln(L / 365 d) = logit(component 4) and ln(1 - t), so that a linear
 layer already forms ln(L / time left). `LogFeaturesObservation` (a single
 environment) and `LogFeaturesVectorObservation` (a vector environment) append them
-to the observation: (7,) -> (9,), float32. Stable-Baselines3's
+to the observation: (7,) -> (9,), float32; the solar task's (11,) -> (13,) (its first
+seven components are these). Stable-Baselines3's
 ``orbit_env.agents.features.LogFeatures`` computes the same inside the network
 from the constants defined here.
 """
@@ -44,7 +45,7 @@ LOG_FEATURE_NAMES = ("log_lifetime", "log_time_left")
 
 
 def log_features(observations: Any) -> NDArray[np.float32]:
-    """The observation(s), then ln(L / 365 d) and ln(1 - clock): (..., 7) -> (..., 9), float32.
+    """The observation(s), then ln(L / 365 d) and ln(1 - clock): (..., 7) -> (..., 9) (or 11 -> 13), float32.
 
     ln(L / 365 d) is logit(``predicted_lifetime``) with the component clamped to
     [`LOG_FLOOR`, 1 - `LOG_FLOOR`]; ln(1 - clock) has 1 - clock clamped below at
@@ -65,8 +66,11 @@ def log_features_space(space: gymnasium.spaces.Box) -> gymnasium.spaces.Box:
     [ln(`LOG_FLOOR`), 0] = [-13.8, 0] for ln(1 - clock), computed by `log_features`
     itself so that every observation it returns lies in the Box.
     """
-    if not (isinstance(space, gymnasium.spaces.Box) and space.shape == (len(OBS_NAMES),)):
-        raise ValueError(f"log features need the orbit-raising observation space, Box of shape (7,); got {space}")
+    if not (isinstance(space, gymnasium.spaces.Box) and len(space.shape) == 1 and space.shape[0] >= len(OBS_NAMES)):
+        raise ValueError(
+            "log features need an orbit-raising observation space, a Box of shape (7,) (the solar task's: (11,), "
+            f"the same seven first); got {space}"
+        )
     ends = log_features(np.stack([space.low, space.high]))
     return gymnasium.spaces.Box(ends.min(axis=0), ends.max(axis=0), dtype=np.float32)
 
