@@ -435,7 +435,10 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--solar-cycle", action="store_true", help="msis: the built-in smooth solar cycle")
     group.add_argument("--cycle-phase", type=number, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")
     group.add_argument(
-        "--epoch", metavar="DATE", help="msis: the orbit's date: follow the season and the activity from then on"
+        "--epoch",
+        metavar="DATE",
+        help="msis: the orbit's date (YYYY-MM-DD, a time THH:MM in UTC or with its zone; YYYY-MM: the 15th): "
+        "follow the season and the activity from then on",
     )
     group.add_argument(
         "--msis-version",
