@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, task_of
-from orbit_env.envs import SOLAR_ENV_ID
+from orbit_env.envs import SOLAR_ENV_IDS
 
 FloatArray = NDArray[np.float64]
 
@@ -267,10 +267,10 @@ def _solar_plan(job: tuple[Any, dict[str, float]], rollout: bool = False) -> tup
     ``rollout``: the rollout policy on the DP flies (`SolarDP.rollout_burns_m_s`).
     """
     from orbit_env.agents.solar import fly
-    from orbit_env.agents.solar_dp import SolarDP
+    from orbit_env.agents.solar_dp import SolarDP, dp_task
 
     task, option = job
-    dp = SolarDP(task, option["start_day"])
+    dp = SolarDP(dp_task(task), option["start_day"])
     asked: list[float] = []
     policy = dp.rollout_burns_m_s if rollout else dp.burns_m_s
 
@@ -284,6 +284,7 @@ def _solar_plan(job: tuple[Any, dict[str, float]], rollout: bool = False) -> tup
 
 
 def _solar_optimum(
+    env_id: str,
     episodes: int,
     seed: int,
     env_kwargs: dict[str, Any],
@@ -300,11 +301,11 @@ def _solar_optimum(
     from orbit_env.agents.solar import map_missions, starts
     from orbit_env.envs import solar_task
 
-    probe = gymnasium.make(SOLAR_ENV_ID, **env_kwargs)
+    probe = gymnasium.make(env_id, **env_kwargs)
     task = probe.unwrapped.task
     probe.close()
     options = starts(task, episodes, seed)
-    plans = _Plans(SOLAR_ENV_ID, options, env_kwargs)
+    plans = _Plans(env_id, options, env_kwargs)
     say(f"dp: {episodes} missions, one DP each")
     solved = map_missions(task, options, partial(_solar_plan, rollout=rollout), workers)
     returns, burns = np.zeros(episodes), np.zeros((episodes, plans.horizon))
@@ -354,15 +355,15 @@ def certify(
     say = progress or (lambda text: None)
     start_time = time.perf_counter()
     say("dp (solving and playing)")
-    if env_id == SOLAR_ENV_ID:
+    if env_id in SOLAR_ENV_IDS:
         solar = {"solar_split": "test", **(env_kwargs or {})}
-        optimum = _solar_optimum(episodes, seed, solar, workers, say, rollout=dp_rollout)
+        optimum = _solar_optimum(env_id, episodes, seed, solar, workers, say, rollout=dp_rollout)
     else:
         optimum = _known_density_optimum(env_id, episodes, seed, policy, dp_lookahead, dp_rollout)
     plans, dp_returns, dp_burns = optimum.plans, optimum.returns, optimum.burns_m_s
     everyone = np.arange(episodes)
     replay_error = 0.0
-    if env_id == SOLAR_ENV_ID:  # the burns the DP asked for, as an open-loop plan in the env, give its return back
+    if env_id in SOLAR_ENV_IDS:  # the burns the DP asked for, as an open-loop plan in the env, give its return back
         replay_error = float(np.max(np.abs(plans.score(everyone, dp_burns) - dp_returns)))
     best, best_returns = dp_burns.copy(), dp_returns.copy()
     early = _early_plans(plans)
@@ -412,7 +413,7 @@ def format_certificate(summary: dict[str, Any]) -> str:
     """The certificate as text for people."""
     policy = summary.get("policy", "DP policy")
     replayed = "the winners in gymnasium.make" + (
-        "; the solar DP's own in the vector env" if summary["env"] == SOLAR_ENV_ID else ""
+        "; the solar DP's own in the vector env" if summary["env"] in SOLAR_ENV_IDS else ""
     )
     return "\n".join(
         [

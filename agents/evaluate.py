@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 from orbit_env.agents.policies import HAND_CODED
-from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS
 
 FloatArray = NDArray[np.float64]
 
@@ -71,13 +71,13 @@ class Episodes:
 
 def check_env_id(env_id: str) -> None:
     """ValueError unless ``env_id`` is a known-density environment (the solar task has an evaluation of its own)."""
-    if env_id == SOLAR_ENV_ID:
+    if env_id in SOLAR_ENV_IDS:
         raise ValueError(
-            f"{SOLAR_ENV_ID} is scored by orbit_env.agents.solar.evaluate_solar (its missions, a DP each); "
+            f"{env_id} is scored by orbit_env.agents.solar.evaluate_solar (its missions, a DP each); "
             f"here: {', '.join(ENV_IDS)}"
         )
     if env_id not in ENV_IDS:
-        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join((*ENV_IDS, SOLAR_ENV_ID))}")
+        raise ValueError(f"unknown environment {env_id!r}; allowed: {', '.join((*ENV_IDS, *SOLAR_ENV_IDS))}")
 
 
 def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any]:
@@ -275,6 +275,7 @@ SHIPPED_MODELS = {
     "OrbitRaisingUncertain-v0": "ppo_orbit_raising_uncertain.zip",
     "OrbitRaisingContinuous-v0": "ppo_orbit_raising_continuous.zip",
     "OrbitRaisingSolar-v0": "ppo_orbit_raising_solar.zip",
+    "OrbitRaisingSolarContinuous-v0": "ppo_orbit_raising_solar_continuous.zip",
 }
 
 
@@ -366,7 +367,7 @@ def load_model(
     """
     from importlib import resources
 
-    if env_id != SOLAR_ENV_ID:
+    if env_id not in SOLAR_ENV_IDS:
         check_env_id(env_id)
     if model_path is None:
         if env_id not in SHIPPED_MODELS:

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from orbit_env.agents import VALIDATION_SEED
 from orbit_env.agents.evaluate import Episodes, predicted_actions
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
-from orbit_env.envs import solar_task
+from orbit_env.envs import SOLAR_ENV_ID, solar_task
 from orbit_env.envs import task as task_model
 from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SolarMission, SolarStep, SolarTask
 from orbit_env.envs.state import BatchState
@@ -237,35 +237,48 @@ def by_observation(task: SolarTask, policy: Never) -> Callable[[BatchState], Flo
 
 
 def by_model(task: SolarTask, model: Any) -> Callable[[BatchState], FloatArray]:
-    """A learned model (SB3's ``predict``) as `fly`'s ``act``: deterministic actions on the observation."""
-    sizes = np.array(task.config.burn_sizes_m_s)
+    """A learned model (SB3's ``predict``) as `fly`'s ``act``: deterministic actions on the observation.
+
+    The actions become burns as the task's environment reads them (`orbit_env.envs.task.Task.requested_dvs`:
+    a burn size's index, or the continuous twin's a in [-1, 1]).
+    """
 
     def act(state: BatchState) -> FloatArray:
-        return sizes[predicted_actions(model, solar_task.observe(task, state), task.action_space)]
+        actions = predicted_actions(model, solar_task.observe(task, state), task.action_space)
+        return task.requested_dvs(actions, state.size)
 
     return act
 
 
-def fly_model(model: Any, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> Flown:
+def fly_model(
+    model: Any, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None, env_id: str = SOLAR_ENV_ID
+) -> Flown:
     """A learned model's missions: ``episodes`` starts drawn with ``seed`` from the split of ``env_kwargs``.
 
     ``env_kwargs`` are the environment's keywords (the training config's ``[env]`` table; default: the
-    train split), so `orbit_env.agents.train.BestModelCallback` validates on the split trained on.
+    train split), so `orbit_env.agents.train.BestModelCallback` validates on the split trained on;
+    ``env_id`` the solar task's id (its continuous twin's keywords added).
     """
+    import gymnasium
+
     from orbit_env.envs.solar import solar_task_of
 
-    task = solar_task_of(None, dict(env_kwargs or {}))
+    task = solar_task_of(None, {**gymnasium.spec(env_id).kwargs, **(env_kwargs or {})})
     return fly(task, starts(task, episodes, seed), by_model(task, model))
 
 
-@lru_cache(maxsize=4)
 def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
     """The thresholds (and reserves) of the two threshold rules that do best on the train split.
 
     Each candidate flies the same `TUNE_EPISODES` missions of the train split (seed `TUNE_SEED`),
-    whatever split ``task`` is on.
+    whatever split ``task`` is on; the rules burn their sizes, so the continuous twin's are the same.
     """
-    train = SolarTask(config=task.config, mission=_with_split(task.mission, "train"))
+    return _tune(task.config, _with_split(task.mission, "train"))
+
+
+@lru_cache(maxsize=4)
+def _tune(config: Any, mission: SolarMission) -> dict[str, tuple[float, float]]:
+    train = SolarTask(config=config, mission=mission)
     options = starts(train, TUNE_EPISODES, TUNE_SEED)
     best: dict[str, tuple[float, float]] = {}
     for name, cls, grid in (
@@ -325,11 +338,11 @@ def _fly_dp(
     job: tuple[SolarTask, dict[str, float]], rollout: bool = False
 ) -> tuple[float, float, float, float, bool, bool, float]:
     """Solve one mission's DP and fly its policy, or the rollout on it (in a worker: the DP's tables stay there)."""
-    from orbit_env.agents.solar_dp import SolarDP
+    from orbit_env.agents.solar_dp import SolarDP, dp_task
 
     task, option = job
     options = {k: np.array([v]) for k, v in option.items()}
-    dp = SolarDP(task, option["start_day"])
+    dp = SolarDP(dp_task(task), option["start_day"])
     flown = fly(task, options, dp.rollout_burns_m_s if rollout else dp.burns_m_s)
     start = solar_task.start(task, np.random.default_rng(0), 1, options)
     return (
@@ -363,14 +376,18 @@ def evaluate_solar(
     workers: int | None = None,
     progress: Callable[[str], None] | None = None,
     learned: Mapping[str, Any] | None = None,
+    continuous: bool = False,
 ) -> SolarEvaluation:
     """Fly every hand-coded rule, the optimum and the ``learned`` agents on ``episodes`` missions of the split.
 
     The missions are drawn with ``seed``. ``learned``: row name -> a model answering SB3's ``predict``
     (e.g. ``{"ppo": model}``), flown with deterministic actions after the optimum's row. ``dp_rollout``:
     the optimum's row is the rollout policy on each mission's DP (`SolarDP.rollout_burns_m_s`).
+    ``continuous``: the continuous twin (``OrbitRaisingSolarContinuous-v0``): the learned agents act in
+    its Box, the DP on a finer grid of burns (`orbit_env.agents.solar_dp.dp_task`); the rules are the same.
     """
-    task = SolarTask(mission=SolarMission(solar_split=solar_split, disposal_years=disposal_years))
+    mission = SolarMission(solar_split=solar_split, disposal_years=disposal_years)
+    task = SolarTask(mission=mission, continuous=continuous)
     options = starts(task, episodes, seed)
     say = progress or (lambda _: None)
     say("tuning the thresholds on the train split")

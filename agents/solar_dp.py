@@ -21,7 +21,7 @@ and $V_0$ at the start the grid's estimate of the optimum; their gap is the cert
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -47,6 +47,24 @@ MU_LOW = -14.0
 COAST_MASSES = 3
 #: Months from the start in which `SolarDP.rollout_burns_m_s` decides by flying every burn size to the end.
 ROLLOUT_STEPS = 6
+
+
+#: The continuous twin's DP burns every multiple of this up to the largest burn [m/s] (the discrete task's
+#: smallest burn, 5 m/s, halved): a lower bound of the continuous optimum, as the known-density continuous
+#: variant's DP on its 10 m/s grid (`orbit_env.agents.evaluate.CONTINUOUS_DP_STEP_M_S`).
+CONTINUOUS_DP_STEP_M_S = 2.5
+
+
+def dp_task(task: SolarTask) -> SolarTask:
+    """The task the DP solves: the task itself, or for the continuous twin burns on a `CONTINUOUS_DP_STEP_M_S` grid.
+
+    The DP's policy asks for burns [m/s], which either task flies as they are.
+    """
+    if not task.continuous:
+        return task
+    top = task.config.max_burn_m_s
+    sizes = tuple(float(b) for b in np.arange(0.0, top + 1e-9, CONTINUOUS_DP_STEP_M_S))
+    return replace(task, config=replace(task.config, burn_sizes_m_s=sizes))
 
 
 @dataclass(frozen=True)

@@ -185,9 +185,9 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
 
 def _check_values(config: dict[str, Any], source: str) -> None:
     """The values' ranges and the combinations that cannot work (ValueError naming the key)."""
-    from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
+    from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS
 
-    allowed = (*ENV_IDS, SOLAR_ENV_ID)
+    allowed = (*ENV_IDS, *SOLAR_ENV_IDS)
     if config["env_id"] not in allowed:
         raise ValueError(
             f"{source}: env_id = {config['env_id']!r} is not an orbit_env environment; allowed: {', '.join(allowed)}"
@@ -214,9 +214,9 @@ def _check_values(config: dict[str, Any], source: str) -> None:
         raise ValueError(
             f"{source}: end_decided={config['end_decided']!r} is invalid; allowed: a probability in [0, 1]"
         )
-    if config["env_id"] == SOLAR_ENV_ID and config["shaping"] != "none":
+    if config["env_id"] in SOLAR_ENV_IDS and config["shaping"] != "none":
         raise ValueError(
-            f'{source}: shaping = {config["shaping"]!r} is invalid for {SOLAR_ENV_ID}; allowed: "none" '
+            f'{source}: shaping = {config["shaping"]!r} is invalid for {config["env_id"]}; allowed: "none" '
             "(never_burn_value reads the known-density task's curves)"
         )
     if config["end_decided"] > 0.0 and config["shaping"] != "never_burn_value":
@@ -342,12 +342,12 @@ class BestModelCallback(BaseCallback):
     def evaluate(self) -> float:
         """Score the current policy now; save it if it is the best so far; return its mean return."""
         from orbit_env.agents.evaluate import run_episodes
-        from orbit_env.envs import SOLAR_ENV_ID
+        from orbit_env.envs import SOLAR_ENV_IDS
 
-        if self.env_id == SOLAR_ENV_ID:
+        if self.env_id in SOLAR_ENV_IDS:
             from orbit_env.agents.solar import fly_model
 
-            result = fly_model(self.model, self.episodes, self.seed, self.env_kwargs).episodes()
+            result = fly_model(self.model, self.episodes, self.seed, self.env_kwargs, self.env_id).episodes()
         else:
             result = run_episodes(self.env_id, self.model, self.episodes, self.seed, env_kwargs=self.env_kwargs)
         mean = float(result.returns.mean())

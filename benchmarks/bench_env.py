@@ -19,7 +19,7 @@ equation and ``locate`` on the curves for that subset, numpy calls whose fixed c
 hardly shrinks with the subset. CartPole has no counterpart of that, so the
 random-action ratio is the one that matters for training.
 
-The solar task (``OrbitRaisingSolar-v0``, issue 28: the same targets) is timed last, on
+The solar task (``OrbitRaisingSolar-v0`` and its continuous twin, issue 28: the same targets) is timed last, on
 fewer steps (``--solar-steps``, ``--solar-vector-steps``; its step is costlier), each run
 in turn with CartPole's on as many steps.
 
@@ -37,7 +37,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium.envs.classic_control.cartpole import CartPoleVectorEnv
 
-from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID, register_envs
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS, register_envs
 
 NUM_ENVS = 4096
 
@@ -151,22 +151,29 @@ def main() -> None:
 
 
 def solar(args: argparse.Namespace, rng: np.random.Generator) -> None:
-    """``OrbitRaisingSolar-v0`` against CartPole, single and at `NUM_ENVS`, random actions."""
+    """The solar task's ids (``OrbitRaisingSolar-v0``, its continuous twin) against CartPole, random actions."""
+    for env_id in SOLAR_ENV_IDS:
+        solar_one(env_id, args, rng)
+
+
+def solar_one(env_id: str, args: argparse.Namespace, rng: np.random.Generator) -> None:
+    """One solar id against CartPole: single env, then vector env at `NUM_ENVS`."""
     n, m = args.solar_steps, args.solar_vector_steps
     cartpole = gym.make("CartPole-v1")
     cart_actions = rng.integers(0, 2, n).tolist()
-    env = gym.make(SOLAR_ENV_ID)
-    actions = rng.integers(0, env.action_space.n, n).tolist()
+    env = gym.make(env_id)
+    drawn = draw_actions(env.action_space, rng, (n,))
+    actions = drawn.tolist() if drawn.ndim == 1 else list(drawn)
     t_cart, t_env = best_of(
         args.repeats, lambda: time_single(cartpole, cart_actions), lambda: time_single(env, actions)
     )
-    print(f"{SOLAR_ENV_ID}, random actions, single env, {n} steps, best of {args.repeats}")
+    print(f"{env_id}, random actions, single env, {n} steps, best of {args.repeats}")
     print(f"  {'CartPole-v1':<45} {n / t_cart:>12,.0f} steps/s")
-    print(f"  {SOLAR_ENV_ID:<45} {n / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
+    print(f"  {env_id:<45} {n / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
     cart_vec = CartPoleVectorEnv(num_envs=NUM_ENVS)
-    vec = gym.make_vec(SOLAR_ENV_ID, num_envs=NUM_ENVS)
+    vec = gym.make_vec(env_id, num_envs=NUM_ENVS)
     cart_vec_actions = [rng.integers(0, 2, NUM_ENVS) for _ in range(m)]
-    vec_actions = [rng.integers(0, 4, NUM_ENVS) for _ in range(m)]
+    vec_actions = [draw_actions(vec.single_action_space, rng, (NUM_ENVS,)) for _ in range(m)]
     # The batch's missions start together and end together after 61 steps: the timed steps straddle that
     # end (every mission's rule judged in one step), so the mean step is the steady state's or worse.
     warmup = max(vec.unwrapped.task.config.horizon_steps - m // 2, 0)
@@ -176,9 +183,9 @@ def solar(args: argparse.Namespace, rng: np.random.Generator) -> None:
         lambda: time_vector(vec, vec_actions, warmup),
     )
     per = m * NUM_ENVS
-    print(f"{SOLAR_ENV_ID}, random actions, vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}")
+    print(f"{env_id}, random actions, vector env, {NUM_ENVS} envs x {m} steps, best of {args.repeats}")
     print(f"  {'CartPoleVectorEnv':<45} {per / t_cart:>12,.0f} steps/s")
-    print(f"  {SOLAR_ENV_ID:<45} {per / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
+    print(f"  {env_id:<45} {per / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
 
 
 if __name__ == "__main__":

@@ -49,9 +49,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     def warn(message: str) -> None:
         print(f"{PROG}: warning: {message}", file=sys.stderr)
 
-    from orbit_env.envs import SOLAR_ENV_ID
+    from orbit_env.envs import SOLAR_ENV_IDS
 
-    _solar_options(args, args.env == SOLAR_ENV_ID)
+    _solar_options(args, args.env in SOLAR_ENV_IDS)
     if args.plot and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
     if args.certify:
@@ -59,7 +59,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
         return _certify(args, say)
-    if args.env == SOLAR_ENV_ID:
+    if args.env in SOLAR_ENV_IDS:
         return _evaluate_solar(args, say)
     check_env_id(args.env)
     policies = all_policies(
@@ -96,7 +96,10 @@ def _solar_options(args: argparse.Namespace, solar: bool) -> None:
     given = [f"--{name.replace('_', '-')}" for name in only_solar if getattr(args, name) is not None]
     if not solar and given:
         verb = "applies" if len(given) == 1 else "apply"
-        raise ValueError(f"{', '.join(given)} {verb} to OrbitRaisingSolar-v0 only, not to {args.env}")
+        raise ValueError(
+            f"{', '.join(given)} {verb} to the solar task only (OrbitRaisingSolar-v0 and its continuous twin), "
+            f"not to {args.env}"
+        )
     if solar and args.dp_lookahead is not None:
         raise ValueError("--dp-lookahead applies to the known-density envs; the solar DP's policy looks a month ahead")
     args.solar_split = "test" if args.solar_split is None else args.solar_split
@@ -114,6 +117,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
     from orbit_env.agents.evaluate import format_table, load_model, paired_difference, plot_returns, summarize
     from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
+    from orbit_env.envs import SOLAR_CONTINUOUS_ENV_ID
 
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
     loaded = load_model(args.env, args.model, warn=lambda text: print(f"{PROG}: warning: {text}", file=sys.stderr))
@@ -128,6 +132,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         workers=args.workers,
         progress=say,
         learned=learned,
+        continuous=args.env == SOLAR_CONTINUOUS_ENV_ID,
     )
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
     if args.plot:
@@ -178,7 +183,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
 
 def _certify(args: argparse.Namespace, say: Any) -> int:
     from orbit_env.agents.certify import certify, format_certificate
-    from orbit_env.envs import SOLAR_ENV_ID
+    from orbit_env.envs import SOLAR_ENV_IDS
 
     solar = {"solar_split": args.solar_split, "disposal_years": args.disposal_years}
     certificate = certify(
@@ -187,7 +192,7 @@ def _certify(args: argparse.Namespace, say: Any) -> int:
         args.seed,
         dp_lookahead=args.dp_lookahead,
         dp_rollout=args.dp_rollout,
-        env_kwargs=solar if args.env == SOLAR_ENV_ID else None,
+        env_kwargs=solar if args.env in SOLAR_ENV_IDS else None,
         workers=args.workers,
         progress=say,
     )
@@ -288,13 +293,13 @@ def add_parsers(sub: Any) -> None:
         type=int,
         choices=(1, 2),
         help="steps the DP policy takes exactly before reading its grid (default 1; 2 is closer to the optimum; "
-        "not OrbitRaisingSolar-v0, whose DP policy looks one month ahead)",
+        "not the solar task, whose DP policy looks one month ahead)",
     )
     ev.add_argument(
         "--dp-rollout",
         action="store_true",
         help="the DP row is the rollout policy on the DP: certified, slower (see docs/dp.md; "
-        "OrbitRaisingSolar-v0: its first months decided by flying every burn, docs/solar-task.md)",
+        "the solar task: its first months decided by flying every burn, docs/solar-task.md)",
     )
     ev.add_argument(
         "--certify",
@@ -304,19 +309,19 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--solar-split",
         choices=("train", "test"),
-        help="OrbitRaisingSolar-v0: the record's split the missions are drawn from (default test: cycles 24-25)",
+        help="the solar task: the record's split the missions are drawn from (default test: cycles 24-25)",
     )
     ev.add_argument(
         "--disposal-years",
         type=float,
         metavar="Y",
-        help="OrbitRaisingSolar-v0: the disposal rule, re-entry within Y years of the mission's end (default 5)",
+        help="the solar task: the disposal rule, re-entry within Y years of the mission's end (default 5)",
     )
     ev.add_argument(
         "--workers",
         type=positive_int,
         metavar="N",
-        help="OrbitRaisingSolar-v0: processes solving the DPs, also with --certify (default: cores)",
+        help="the solar task: processes solving the DPs, also with --certify (default: cores)",
     )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")

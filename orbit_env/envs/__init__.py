@@ -6,6 +6,7 @@
 | ``OrbitRaisingContinuous-v0`` | Box [-1, 1]: burn size | the paper's, known                        |
 | ``OrbitRaisingUncertain-v0``  | Discrete: burn sizes   | scale drawn per episode, hidden, drifting |
 | ``OrbitRaisingSolar-v0``      | Discrete: burn sizes   | NRLMSIS under the real Sun; disposal rule |
+| ``OrbitRaisingSolarContinuous-v0`` | Box [-1, 1]: burn size | the solar task's, with any burn size |
 
 Each has a single environment (``gymnasium.make``) and a numpy-batched vector
 environment (``gymnasium.make_vec(id, num_envs=N)``, autoreset ``NEXT_STEP`` by default);
@@ -33,7 +34,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ENV_IDS",
+    "SOLAR_CONTINUOUS_ENV_ID",
     "SOLAR_ENV_ID",
+    "SOLAR_ENV_IDS",
     "DensityConfig",
     "OrbitRaisingConfig",
     "OrbitRaisingEnv",
@@ -56,8 +59,12 @@ _VARIANTS: dict[str, dict[str, object]] = {
     "OrbitRaisingContinuous-v0": {"continuous": True},
     "OrbitRaisingUncertain-v0": {"density": UNCERTAIN_DENSITY},
 }
-#: The solar decision task's id (its own task model, `orbit_env.envs.solar_task`).
+#: The solar decision task's id (its own task model, `orbit_env.envs.solar_task`), and its continuous twin's.
 SOLAR_ENV_ID = "OrbitRaisingSolar-v0"
+SOLAR_CONTINUOUS_ENV_ID = "OrbitRaisingSolarContinuous-v0"
+#: The ids of the solar task, and the keywords that make each.
+_SOLAR_VARIANTS: dict[str, dict[str, object]] = {SOLAR_ENV_ID: {}, SOLAR_CONTINUOUS_ENV_ID: {"continuous": True}}
+SOLAR_ENV_IDS = tuple(_SOLAR_VARIANTS)
 _SOLAR_ENTRY_POINTS = ("orbit_env.envs.solar:OrbitRaisingSolarEnv", "orbit_env.envs.solar:OrbitRaisingSolarVectorEnv")
 #: The ids of the known-density family (one task model, `orbit_env.envs.task`).
 ENV_IDS = tuple(_VARIANTS)
@@ -73,7 +80,7 @@ def register_envs() -> None:
     import gymnasium
 
     entry_points = {env_id: (_ENTRY_POINT, _VECTOR_ENTRY_POINT) for env_id in _VARIANTS}
-    entry_points[SOLAR_ENV_ID] = _SOLAR_ENTRY_POINTS
+    entry_points.update({env_id: _SOLAR_ENTRY_POINTS for env_id in SOLAR_ENV_IDS})
     for env_id, (entry_point, vector_entry_point) in entry_points.items():
         if env_id in gymnasium.registry:
             continue
@@ -81,7 +88,7 @@ def register_envs() -> None:
             id=env_id,
             entry_point=entry_point,
             vector_entry_point=vector_entry_point,
-            kwargs=dict(_VARIANTS.get(env_id, {})),
+            kwargs=dict({**_VARIANTS, **_SOLAR_VARIANTS}[env_id]),
         )
 
 

@@ -38,11 +38,15 @@ def solar_task_of(config: OrbitRaisingConfig | dict[str, Any] | None, keywords: 
     Raises:
         ValueError: an unknown keyword (the valid ones named) or a bad value.
     """
+    keywords = dict(keywords)
+    continuous = keywords.pop("continuous", False)
+    if not isinstance(continuous, (bool, np.bool_)):
+        raise ValueError(f"continuous={continuous!r} is invalid; allowed: True or False")
     mission_fields = {f.name for f in dataclasses.fields(SolarMission)}
     config_fields = {f.name for f in dataclasses.fields(OrbitRaisingConfig)}
     unknown = [k for k in keywords if k not in mission_fields and k not in config_fields]
     if unknown:
-        valid = sorted({"config", "render_mode", *mission_fields, *config_fields})
+        valid = sorted({"config", "continuous", "render_mode", *mission_fields, *config_fields})
         raise ValueError(f"unknown keyword {unknown[0]!r}; valid keywords: {', '.join(valid)}")
     base = SOLAR_CONFIG if config is None else config
     if isinstance(base, dict):
@@ -51,7 +55,8 @@ def solar_task_of(config: OrbitRaisingConfig | dict[str, Any] | None, keywords: 
         raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig, a dict of its fields or None")
     overrides = {k: v for k, v in keywords.items() if k in config_fields}
     mission = SolarMission(**{k: v for k, v in keywords.items() if k in mission_fields})
-    task = SolarTask(config=dataclasses.replace(base, **overrides) if overrides else base, mission=mission)
+    config = dataclasses.replace(base, **overrides) if overrides else base
+    task = SolarTask(config=config, mission=mission, continuous=bool(continuous))
     _ = task.start_window  # the mission must fit its split of the record: a ValueError now, not at reset()
     return task
 
@@ -75,6 +80,8 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
 
     ## Action Space
     ``Discrete(4)``: a perigee burn of 0, 5, 10 or 20 m/s this month (cut to the propellant left).
+    ``OrbitRaisingSolarContinuous-v0`` (``continuous=True``), the continuous twin: ``Box(-1, 1, (1,))``,
+    a burn of 20 m/s x max(a, 0) (``max_burn_m_s``; a <= 0 coasts, as in ``OrbitRaisingContinuous-v0``).
 
     ## Observation Space
     ``Box(0, high, (11,), float32)``; only the past, never the future:
@@ -115,9 +122,10 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     next step's first day, ISO); at the end also ``disposal_dv_m_s`` and ``complies``.
 
     ## Arguments
-    ``solar_split`` ("train" or "test"), ``disposal_years`` (0.5-25), ``block_days``,
-    ``inclination_deg``, ``start_span_km``, and any field of `OrbitRaisingConfig` (the satellite,
-    the burn sizes, ``horizon_steps``, ``propellant_cost_per_m_s``, ``start_perigee_km``).
+    ``continuous`` (the twin's action space), ``solar_split`` ("train" or "test"), ``disposal_years``
+    (0.5-25), ``block_days``, ``inclination_deg``, ``start_span_km``, and any field of
+    `OrbitRaisingConfig` (the satellite, the burn sizes, ``horizon_steps``, ``propellant_cost_per_m_s``,
+    ``start_perigee_km``).
     ``render_mode``: "rgb_array" and "human" draw the (apogee, perigee) plane with the track, a
     month with a burn in red, over the paper's curves as the other environments draw them (needs
     ``orbit-env[plot]``; Stable-Baselines3's ``make_vec_env`` asks for "rgb_array"); "ansi" returns
@@ -127,6 +135,7 @@ class OrbitRaisingSolarEnv(gym.Env[NDArray[np.float32], np.int64]):
     * v0: initial version (2026-12-04).
     * v0, episode end changed 2026-12-06 (unreleased, so the id stayed): the mission's end is
       ``terminated``, as re-entry is; it was ``truncated``. Rewards and dynamics are unchanged.
+    * ``OrbitRaisingSolarContinuous-v0``: v0, initial version (2026-12-06).
     """
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["human", "rgb_array", "ansi"], "render_fps": 4}

@@ -144,7 +144,7 @@ def test_a_policys_bad_actions_are_refused_naming_it_not_rounded_or_wrapped(make
 def test_the_solar_task_is_sent_to_its_own_evaluation_and_every_id_is_named():
     with pytest.raises(ValueError, match=r"OrbitRaisingSolar-v0 is scored by orbit_env.agents.solar.evaluate_solar"):
         run_episodes("OrbitRaisingSolar-v0", NeverBurn(), episodes=2)
-    with pytest.raises(ValueError, match=r"allowed: OrbitRaising-v0, .*, OrbitRaisingSolar-v0$"):
+    with pytest.raises(ValueError, match=r"allowed: OrbitRaising-v0, .*, OrbitRaisingSolarContinuous-v0$"):
         run_episodes("Foo-v0", NeverBurn(), episodes=2)
 
 

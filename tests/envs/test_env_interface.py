@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from gymnasium.wrappers import TimeLimit
 
-from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID, register_envs
+from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID, SOLAR_ENV_IDS, register_envs
 from orbit_env.envs.config import DEFAULT_HORIZON_STEPS
 
 if not all(env_id in gym.envs.registry for env_id in ENV_IDS):
@@ -213,7 +213,7 @@ def test_sb3_infos_hold_each_finished_episodes_outcome():
     assert finished[1]["reentered"] is False and finished[1]["dv_used_m_s"] == 0.0
 
 
-@pytest.mark.parametrize("env_id", [*ENV_IDS, SOLAR_ENV_ID])
+@pytest.mark.parametrize("env_id", [*ENV_IDS, *SOLAR_ENV_IDS])
 def test_a_step_after_the_end_warns_as_cartpoles_does(env_id):
     import warnings
 
@@ -249,7 +249,7 @@ def test_sb3_infos_hold_the_solar_missions_end():
         assert info["complies"] is True and info["disposal_dv_m_s"] >= 0.0 and info["episode"]["l"] == 3
 
 
-@pytest.mark.parametrize("env_id", [*ENV_IDS, SOLAR_ENV_ID])
+@pytest.mark.parametrize("env_id", [*ENV_IDS, *SOLAR_ENV_IDS])
 def test_sb3s_own_make_vec_env_makes_every_id(env_id):
     # Stable-Baselines3's make_vec_env asks gymnasium.make for render_mode="rgb_array" (retrying without it
     # only on a TypeError): every id must draw frames, the solar task's too (it refused them before).

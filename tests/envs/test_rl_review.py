@@ -62,7 +62,7 @@ def test_the_log_features_serve_the_solar_task():
 
 def test_evaluate_refuses_options_of_the_other_kind_of_env(capsys):
     cases = [
-        (["--env", "OrbitRaising-v0", "--disposal-years", "100"], "--disposal-years applies to OrbitRaisingSolar"),
+        (["--env", "OrbitRaising-v0", "--disposal-years", "100"], "--disposal-years applies to the solar task only"),
         (["--env", "OrbitRaising-v0", "--workers", "2", "--solar-split", "train"], "--solar-split, --workers apply"),
         (["--env", SOLAR_ENV_ID, "--dp-lookahead", "2"], "--dp-lookahead applies to the known-density envs"),
     ]
