@@ -176,7 +176,7 @@ class _Plans:
 
 def _early_plans(plans: _Plans) -> FloatArray:
     """Every combination of early burns on the first `EARLY_STEPS` steps, then coasting: (m, horizon)."""
-    burns = plans.sizes if not plans.continuous else np.asarray(EARLY_BURNS)
+    burns = plans.sizes if not plans.continuous else np.unique(np.minimum(EARLY_BURNS, plans.max_burn))
     grids = np.meshgrid(*([burns] * EARLY_STEPS), indexing="ij")
     early = np.stack([g.ravel() for g in grids], axis=1)
     out = np.zeros((early.shape[0], plans.horizon))

@@ -319,6 +319,9 @@ def sweep(
             raise ValueError(f"unknown algorithm {algo!r}; allowed: {', '.join(SWEEP_ALGOS)}")
         if kind not in SWEEP_ALGOS[algo]:
             raise ValueError(f"{algo} does not act in the {kind} action space of {env_id}")
+    repeated = sorted({algo for algo in algos if list(algos).count(algo) > 1})
+    if repeated:
+        raise ValueError(f"algorithms {', '.join(repeated)} given twice: each is one row of seeds")
     if seeds < 1 or timesteps < 1 or episodes < 1:
         raise ValueError("seeds, timesteps and episodes must be >= 1")
     if cpus is not None and (address is not None or cpus < 1):
@@ -328,9 +331,6 @@ def sweep(
         from ray import tune
     except ImportError as error:
         raise ImportError("orbit-env sweep runs on Ray Tune: pip install 'orbit-env[cluster]'") from error
-    repeated = sorted({algo for algo in algos if list(algos).count(algo) > 1})
-    if repeated:
-        raise ValueError(f"algorithms {', '.join(repeated)} given twice: each is one row of seeds")
     say = progress or (lambda text: None)
     eval_seed = EVAL_SEED if eval_seed is None else eval_seed
     out = Path(out_dir).resolve()
@@ -350,6 +350,11 @@ def sweep(
         kept = json.loads(settings_path.read_text())
         if kept != settings:
             raise ValueError(f"{out} holds a sweep of other settings ({kept}); give another --out to run this one")
+    elif (out / "ray" / "sweep").exists():  # a sweep from before the settings were recorded: whose, unknown
+        raise ValueError(
+            f"{out} holds a sweep that does not record its settings; to resume it as it was started, write them "
+            f"to {settings_path} (these would be {json.dumps(settings)}), or give another --out"
+        )
     else:
         settings_path.write_text(json.dumps(settings) + "\n")
     # The references of the capture, once for all trials (the DP's solve is the heavy part).

@@ -297,7 +297,8 @@ class BestModelCallback(BaseCallback):
         resume: The timesteps of the checkpoint a resumed run continues from: the scores of
             ``save_dir/evaluations.json`` up to it are continued (a new model is saved only if it
             beats them); those after it were of the run being replaced and are dropped, and if
-            one of them made ``best_model.zip``, that file is kept as ``best_model_replaced.zip``.
+            one of them made ``best_model.zip``, that file is kept as ``best_model_replaced.zip`` and
+            this branch's first score makes a new one (the kept scores' model was overwritten).
     """
 
     def __init__(
@@ -311,6 +312,8 @@ class BestModelCallback(BaseCallback):
         resume: int | None = None,
     ) -> None:
         super().__init__(verbose=0)
+        if isinstance(resume, bool):
+            raise ValueError(f"resume={resume!r} is invalid; allowed: None or the checkpoint's timesteps")
         self.env_id = env_id
         self.env_kwargs = dict(env_kwargs)
         self.every_calls = max(int(every_calls), 1)
@@ -328,6 +331,7 @@ class BestModelCallback(BaseCallback):
             replaced = max((e["mean_return"] for e in scores if e["timesteps"] > resume), default=-float("inf"))
             if replaced > self.best_mean and self.best_model_path.is_file():
                 self.best_model_path.replace(self.save_dir / "best_model_replaced.zip")
+                self.best_mean = -float("inf")  # no file holds the kept scores' best: the next score is saved
 
     @property
     def best_model_path(self) -> Path:

@@ -103,7 +103,10 @@ def check_figure(path: str, option: str, inputs: Sequence[tuple[str, str | None]
         ValueError: as `check_output`, or no extension, or one matplotlib does not write.
     """
     check_output(path, option, inputs)
-    from matplotlib.backend_bases import FigureCanvasBase
+    try:
+        from matplotlib.backend_bases import FigureCanvasBase
+    except ImportError as error:  # as orbit_env.optional.pyplot says it, before any computing
+        raise ImportError(f"{option} needs matplotlib: pip install 'orbit-env[plot]'") from error
 
     formats = sorted(FigureCanvasBase.get_supported_filetypes())
     suffix = Path(path).suffix.lower().lstrip(".")

@@ -201,8 +201,10 @@ def _check_element_set_options(args: argparse.Namespace, from_sets: bool, latest
             "--density-scale changes nothing when the drag is calibrated to the air from element sets (the "
             "calibration absorbs the scale); to fly a fitted scale, give the satellite: --mass and --area (or --shape)"
         )
-    tle_epoch = None if latest is None or getattr(args, "tle", None) is None else latest.epoch_iso.rstrip("Z")
-    if tle_epoch is not None and args.epoch is not None and args.epoch != tle_epoch:
+    from orbit_env.decay.solar import unix_days
+
+    from_tle = latest is not None and getattr(args, "tle", None) is not None and args.epoch is not None
+    if from_tle and abs(unix_days(args.epoch) - latest.epoch_days) > 1.0 / 86400.0:  # the same second, any form
         raise ValueError(
             f"--epoch {args.epoch}: the decay starts at the element set's epoch ({latest.epoch_iso}), where its orbit "
             "was measured; drop --epoch (to fly that orbit from another date, give its heights with --perigee/--apogee)"

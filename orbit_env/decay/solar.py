@@ -65,7 +65,7 @@ def unix_days(date: str | _dt.date | np.datetime64) -> float:
         text += "-15"  # a month: its middle (monthly tables' values are the month's)
     try:
         if "T" in text and (text.endswith(("Z", "z")) or "+" in text[10:] or "-" in text[10:]):
-            moment = _dt.datetime.fromisoformat(text)
+            moment = _dt.datetime.fromisoformat(text[:-1] + "Z" if text.endswith("z") else text)
             seconds = (moment - _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)).total_seconds()
             return seconds / 86400.0
         value = np.datetime64(text, "s")

@@ -40,7 +40,6 @@ FloatArray = NDArray[np.float64]
 OUTCOME_KEYS = ("reentered", "days_in_orbit", "dv_used_m_s")
 
 
-#: The keywords of the vector environment besides the config's and the density's fields.
 def batch_seed(seed: Any, num_envs: int) -> int | None:
     """The seed of a batched env's one generator from ``reset(seed=...)``: None, an int, or one int per env.
 
@@ -65,6 +64,7 @@ def batch_seed(seed: Any, num_envs: int) -> int | None:
     return int(np.random.SeedSequence([int(v) for v in values]).generate_state(1, np.uint64)[0])
 
 
+#: The keywords of the vector environment besides the config's and the density's fields.
 _ENV_KEYWORDS = ("num_envs", "config", "continuous", "density", "max_episode_steps", "render_mode", "autoreset_mode")
 
 

@@ -23,6 +23,7 @@ from gymnasium.vector import VectorEnv, VectorObservationWrapper
 from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
+from orbit_env.envs.solar_task import SOLAR_OBS_NAMES
 from orbit_env.envs.task import OBS_INDEX, OBS_NAMES
 
 __all__ = [
@@ -38,6 +39,9 @@ __all__ = [
 
 #: Observation components the log features read (the task model's layout, `orbit_env.envs.task.OBS_INDEX`).
 CLOCK, LIFETIME = OBS_INDEX["mission_clock"], OBS_INDEX["predicted_lifetime"]
+#: The observations the log features read: the known-density task's (7,), the solar task's (11,) (the same
+#: seven first, then the Sun).
+OBSERVATION_SHAPES = ((len(OBS_NAMES),), (len(SOLAR_OBS_NAMES),))
 #: Clamp before the logarithms: a lifetime of about 30 s, a clock a step before 1 of a 365-step mission.
 LOG_FLOOR = 1e-6
 #: Names of the two components appended to the observation, in order.
@@ -66,7 +70,7 @@ def log_features_space(space: gymnasium.spaces.Box) -> gymnasium.spaces.Box:
     [ln(`LOG_FLOOR`), 0] = [-13.8, 0] for ln(1 - clock), computed by `log_features`
     itself so that every observation it returns lies in the Box.
     """
-    if not (isinstance(space, gymnasium.spaces.Box) and len(space.shape) == 1 and space.shape[0] >= len(OBS_NAMES)):
+    if not (isinstance(space, gymnasium.spaces.Box) and space.shape in OBSERVATION_SHAPES):
         raise ValueError(
             "log features need an orbit-raising observation space, a Box of shape (7,) (the solar task's: (11,), "
             f"the same seven first); got {space}"

@@ -230,3 +230,33 @@ def test_solar_command_without_a_subcommand_names_them(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["solar"])
     assert stop.value.code == 2 and "the following arguments are required: {show,update}" in capsys.readouterr().err
+
+
+def test_an_epoch_given_as_the_sets_own_is_accepted_in_any_form(capsys, beesat):
+    plain = json.loads(run(capsys, "lifetime", "--tle", beesat, "--json")[1])
+    for form in ("2023-08-20T15:28:19Z", "2023-08-20T17:28:19+02:00", "2023-08-20T15:28:19"):
+        status, out, err = run(capsys, "lifetime", "--tle", beesat, "--epoch", form, "--json")
+        assert status == 0 and json.loads(out)["days"] == plain["days"], (form, err)
+
+
+def test_fit_density_names_a_three_line_element_set_file(capsys, tmp_path):
+    tle = tmp_path / "named.tle"
+    tle.write_text("BEESAT 4\n" + last_lines(SETS / "41619_beesat4.tle", 2))
+    status, _, err = run(capsys, "fit-density", tle)
+    assert status == 2 and "holds element sets, not observed orbits" in err
+
+
+def test_a_plot_without_matplotlib_names_the_extra_before_any_decay(capsys, monkeypatch, tmp_path):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_matplotlib(name, *args, **kwargs):
+        if name.startswith("matplotlib"):
+            raise ImportError("No module named 'matplotlib'")
+        return real_import(name, *args, **kwargs)
+
+    never_computed(monkeypatch)
+    monkeypatch.setattr(builtins, "__import__", no_matplotlib)
+    status, _, err = run(capsys, "lifetime", "--perigee", 300, "--apogee", 300, "--plot", tmp_path / "p.png")
+    assert status == 2 and err == "orbit-env: error: --plot needs matplotlib: pip install 'orbit-env[plot]'\n"

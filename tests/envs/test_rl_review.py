@@ -93,6 +93,10 @@ def test_sweeps_and_curves_refuse_a_seed_counted_twice_and_a_folder_of_other_set
         sweep("OrbitRaising-v0", ["a2c", "a2c"], 1, 64, tmp_path / "s", episodes=5, include_dp=False)
     with pytest.raises(ValueError, match="algorithms ppo given twice"):
         curves("OrbitRaising-v0", ["ppo", "ppo"], 1, 64, 64, tmp_path / "c")
+    legacy = tmp_path / "legacy"
+    (legacy / "ray" / "sweep").mkdir(parents=True)  # a sweep from before the settings were recorded
+    with pytest.raises(ValueError, match="holds a sweep that does not record its settings"):
+        sweep("OrbitRaising-v0", ["a2c"], 1, 64, legacy, episodes=5, include_dp=False)
     folder = tmp_path / "old"
     folder.mkdir()
     kept = {"env": "OrbitRaising-v0", "algos": ["a2c"], "seeds": 1, "timesteps": 64, "episodes": 5}
@@ -106,13 +110,21 @@ def test_a_resumed_run_scores_no_timestep_twice(tmp_path):
     (tmp_path / "evaluations.json").write_text(json.dumps(scores))
     (tmp_path / "best_model.zip").write_text("the 4096-step model")
     callback = train.BestModelCallback("OrbitRaising-v0", {}, 1, 5, VALIDATION_SEED, tmp_path, resume=2048)
-    assert callback.evaluations == scores[:1] and callback.best_mean == 10.0
-    # The best model was the replaced branch's: kept aside, not passed off as this branch's.
-    assert not (tmp_path / "best_model.zip").exists()
+    assert callback.evaluations == scores[:1]
+    # The best model was the replaced branch's: kept aside, not passed off as this branch's; no file holds the
+    # kept 2048-step score's model (the run overwrote it), so this branch's first score makes best_model.zip.
+    assert not (tmp_path / "best_model.zip").exists() and callback.best_mean == -float("inf")
     assert (tmp_path / "best_model_replaced.zip").read_text() == "the 4096-step model"
+    with pytest.raises(ValueError, match="resume=True is invalid"):
+        train.BestModelCallback("OrbitRaising-v0", {}, 1, 5, VALIDATION_SEED, tmp_path, resume=True)
+    # Without a replaced best, the kept scores stand: the best model on disk is theirs.
+    (tmp_path / "evaluations.json").write_text(json.dumps(scores))
+    (tmp_path / "best_model.zip").write_text("the 4096-step model")
+    kept = train.BestModelCallback("OrbitRaising-v0", {}, 1, 5, VALIDATION_SEED, tmp_path, resume=4096)
+    assert kept.best_mean == 12.0 and (tmp_path / "best_model.zip").exists()
 
 
 def test_the_solar_recipe_is_validated_on_the_missions_the_rules_are_tuned_on():
     text = resources.files("orbit_env.agents").joinpath("ppo_solar.toml").read_text()
     config = tomllib.loads(text)
-    assert config["eval_episodes"] == solar.TUNE_EPISODES and solar.TUNE_SEED == VALIDATION_SEED
+    assert config["eval_episodes"] == solar.TUNE_EPISODES
