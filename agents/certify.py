@@ -339,7 +339,8 @@ def certify(
         seed: Seed of the starts.
         rounds: Rounds of hill climbing.
         perturbations: Random changes tried per start and round.
-        policy: The policy to certify (default: the env's DP policy; known-density envs).
+        policy: The policy to certify (default: the env's DP policy; known-density envs only, the solar
+            task's certificate is its DP's).
         dp_lookahead: The DP policy's ``lookahead`` (`orbit_env.agents.dp.DPPolicy`).
         dp_rollout: Certify the rollout policy on the DP (`orbit_env.agents.evaluate.dp_policy`).
         env_kwargs: The solar env's keywords (``solar_split``, default ``test`` as ``evaluate``'s; ``disposal_years``).
@@ -352,6 +353,11 @@ def certify(
     """
     if episodes < 1 or rounds < 0 or perturbations < 1:
         raise ValueError("episodes and perturbations must be >= 1, rounds >= 0")
+    if env_id in SOLAR_ENV_IDS and policy is not None:
+        raise ValueError(
+            f"{env_id}: the certificate searches plans against each mission's DP policy only; score your policy "
+            "with orbit_env.agents.solar.evaluate_solar (learned={...}) against that DP"
+        )
     say = progress or (lambda text: None)
     start_time = time.perf_counter()
     say("dp (solving and playing)")
@@ -421,9 +427,13 @@ def format_certificate(summary: dict[str, Any]) -> str:
             f"(seed {summary['seed']}), {summary['plans_scored']:,} plans scored in {summary['wall_s']:.0f} s",
             f"{policy}'s mean return {summary['dp_mean_return']:.3f} days",
             f"gap found (best plan - {policy}): mean {summary['mean_gap_days']:.3f} day, "
-            f"worst {summary['worst_gap_days']:.3f} day (episode {summary['worst_episode']}, "
-            f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km"
-            + (f", from {summary['worst_start_date']})" if "worst_start_date" in summary else ")"),
+            + (
+                f"worst {summary['worst_gap_days']:.3f} day (episode {summary['worst_episode']}, "
+                f"{summary['worst_start_km'][0]:.2f} x {summary['worst_start_km'][1]:.2f} km"
+                + (f", from {summary['worst_start_date']})" if "worst_start_date" in summary else ")")
+                if summary["worst_gap_days"] > TIE_DAYS
+                else "on no start a better plan"
+            ),
             f"starts where the {'DP' if policy == 'DP policy' else policy} was beaten: {summary['beaten_at_all']} "
             f"by more than {TIE_DAYS} day, "
             f"{summary['beaten_above_0.1_day']} by more than 0.1 day",

@@ -92,6 +92,8 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     returned = policy.predict(observations, deterministic=True)
     if not (isinstance(returned, tuple) and len(returned) == 2):
         raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
+    if np.asarray(returned[0]).dtype == np.bool_:
+        raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
     try:
         actions = np.asarray(returned[0], dtype=np.float64)
     except (TypeError, ValueError):
@@ -260,7 +262,7 @@ def plot_returns(results: Mapping[str, Episodes], env_id: str, path: str) -> Non
     fig, ax = plt.subplots(figsize=(8, 4.5), dpi=120)
     names = list(results)
     ax.boxplot([results[n].returns for n in names], showmeans=True)
-    ax.set_xticks(range(1, len(names) + 1), names)
+    ax.set_xticks(range(1, len(names) + 1), names, rotation=30, ha="right")
     ax.set_ylabel("episode return [days - cost x m/s]")
     ax.set_title(f"{env_id}: returns on {next(iter(results.values())).returns.size} seeded episodes", fontsize=10)
     ax.grid(alpha=0.3, axis="y")

@@ -217,7 +217,7 @@ def fly_from(
     while running.any():
         rows = np.flatnonzero(running)
         sub = state.take(rows)
-        result = solar_task.step(task, sub, act(sub))
+        result = solar_task.step(task, sub, checked_burns(task, act(sub), sub.size))
         state.put(rows, sub)
         if on_step is not None:
             on_step(rows, sub, result)
@@ -228,6 +228,26 @@ def fly_from(
         reentered[rows] |= result.terminated
         running[rows] = ~(result.terminated | result.truncated)
     return Flown(total, state.time_days.copy(), dv, disposal, complies, reentered)
+
+
+def checked_burns(task: SolarTask, burns_m_s: Any, n: int) -> FloatArray:
+    """The burns an ``act`` of `fly` asked for, as the environment would let them be flown, or an error.
+
+    Each a burn [m/s] of the task's sizes (the continuous twin: from 0 to ``max_burn_m_s``); one per
+    mission flying (or one for all). A plan a policy could not fly in the environment is not scored.
+
+    Raises:
+        ValueError: a burn that is not a number, negative, NaN, above the largest, or (discrete) not a size.
+    """
+    burns = np.broadcast_to(np.asarray(burns_m_s, dtype=np.float64), (n,))
+    top = task.config.max_burn_m_s
+    bad = ~np.isfinite(burns) | (burns < 0.0) | (burns > top)
+    if not task.continuous:
+        bad |= ~np.isin(burns, np.asarray(task.config.burn_sizes_m_s, dtype=np.float64))
+    if bad.any():
+        allowed = f"0 to {top:g} m/s" if task.continuous else f"the burn sizes {task.config.burn_sizes_m_s} m/s"
+        raise ValueError(f"a burn of {burns[bad][0]:g} m/s asked for; allowed: {allowed}")
+    return burns
 
 
 def by_observation(task: SolarTask, policy: Never) -> Callable[[BatchState], FloatArray]:

@@ -136,7 +136,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     )
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
     if args.plot:
-        plot_returns(results, args.env, args.plot)
+        plot_returns(results, f"{args.env} ({args.solar_split} split)", args.plot)
     table = summarize(results)
     report = solar_report(evaluation)
     # Episode by episode: the optimum against the best operators' rule (the task's headroom), the learned

@@ -320,6 +320,7 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._state: BatchState | None = None
+        self._starts: dict[str, FloatArray] = {}  # the current missions' start options (`start_options`)
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
         self._dv_used = np.zeros(self.num_envs)
 
@@ -340,6 +341,7 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         if seed is not None:
             self._np_random, self._np_random_seed = gym.utils.seeding.np_random(batch_seed(seed, self.num_envs))
         self._state = solar_task.start(self.task, self.np_random, self.num_envs, options)
+        self._starts = solar_task.start_options(self._state)
         self._needs_reset[:] = False
         self._dv_used[:] = 0.0
         return solar_task.observe(self.task, self._state), self._outcome(np.ones(self.num_envs, dtype=bool))
@@ -396,9 +398,23 @@ class OrbitRaisingSolarVectorEnv(VectorEnv):
         # The mission's end is a terminal state of the task, as re-entry is (`orbit_env.envs`).
         return obs, reward, ends.copy(), np.zeros(n, dtype=bool), info
 
+    @property
+    def start_options(self) -> dict[str, FloatArray]:
+        """The reset options that give every current mission's start back exactly (arrays of shape (num_envs,)).
+
+        For the mission each sub-environment is in, whether ``reset`` or an automatic reset began it:
+        ``reset(options=envs.start_options)`` restarts all of them, and row i's values
+        (``{k: v[i] for k, v in ...items()}``) restart mission i in a single environment.
+        """
+        if self._state is None:
+            raise RuntimeError("the environment has no state before reset()")
+        return {name: row.copy() for name, row in self._starts.items()}
+
     def _restart(self, rows: NDArray[np.intp]) -> NDArray[np.float32]:
         fresh = solar_task.start(self.task, self.np_random, rows.size)
         self.task_state.put(rows, fresh)
+        for name, row in solar_task.start_options(fresh).items():
+            self._starts[name][rows] = row
         self._dv_used[rows] = 0.0
         return solar_task.observe(self.task, fresh)
 

@@ -187,7 +187,8 @@ class Task:
             one = action.item()  # the action space's own form, without numpy calls on a 1-element array
             if one == one:  # False for NaN
                 return self.config.max_burn_m_s * min(max(one, 0.0), 1.0)
-        value = np.asarray(action, dtype=np.float64) if not isinstance(action, (str, bytes)) else np.array(np.nan)
+        typed = isinstance(action, (str, bytes, bool, np.bool_)) or getattr(action, "dtype", None) == np.bool_
+        value = np.array(np.nan) if typed else np.asarray(action, dtype=np.float64)
         if value.shape not in ((), (1,)) or np.isnan(value).any():
             raise ValueError(f"action={action!r} is invalid; allowed: one number, not NaN (clipped to [-1, 1])")
         return self.config.max_burn_m_s * min(max(float(value.reshape(())), 0.0), 1.0)
