@@ -1,5 +1,7 @@
 """The disk cache of long-built tables (orbit_env.cache): keyed by their inputs, atomic, movable, can be disabled."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -78,6 +80,9 @@ def test_no_cache_flag_writes_nothing(folder, monkeypatch, capsys):
     args += ["--rho0", "2e-11", "--h0-km", "350", "--scale-height-km", "55", "--method", "curves"]
     assert main([*args, "--no-cache"]) == 0
     assert not list(folder.iterdir())
+    # The worker processes a batch starts read the cache's setting from the environment: it says off too.
+    assert os.environ[cache.ENV_VAR] == "off"
+    monkeypatch.setenv(cache.ENV_VAR, str(folder))
     monkeypatch.setattr(cache, "_disabled", False)
     args[args.index("2e-11")] = "3e-11"  # another atmosphere: not in this process's memory either
     assert main(args) == 0

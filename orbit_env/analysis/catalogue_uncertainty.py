@@ -83,7 +83,8 @@ def uncertain_lifetimes(
         rule_years=rule_years,
         progress=False,
         exact_groups=True,
-        epoch_days=orbits.epoch_days if own_epochs else None,
+        # Dated: the nominal re-entry's epoch and date columns, as a batch without bands has them.
+        epoch_days=orbits.epoch_days if own_epochs else _common_epochs(len(orbits.rows), scenario),
     )
     for i, record in enumerate(records):
         status = record.pop("status")
@@ -98,6 +99,11 @@ def uncertain_lifetimes(
             columns.update(_row_columns(orbits, i, air, samples, seed, rule_years, dated))
         record.update(columns, status=status)
     return records
+
+
+def _common_epochs(n: int, scenario: Scenario) -> Any:
+    """Every row's start, the scenario's epoch, in a dated batch of one date (None undated)."""
+    return None if scenario.epoch_days is None else np.full(n, scenario.epoch_days)
 
 
 def _row_columns(

@@ -305,8 +305,9 @@ def element_set_orbits(
     unread = {}  # catalogue number -> the first set of it that could not be read
     for bad in bad_sets:
         unread.setdefault(bad.catalogue_number, bad)
-    rows = [{"name": s.name} for s in latest]
-    rows += [{"name": bad.name or number} for number, bad in unread.items() if number not in histories]
+    # The catalogue number is the row's id (a name line would otherwise hide it).
+    rows = [{"name": s.name, "id": s.catalogue_number} for s in latest]
+    rows += [{"name": bad.name or number, "id": number} for number, bad in unread.items() if number not in histories]
     n = len(rows)
     hp = np.full(n, np.nan)
     ha = np.full(n, np.nan)

@@ -9,6 +9,7 @@ cause ends in one line on stderr and exit status 2, in the command line's words.
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Sequence
 
@@ -52,6 +53,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.no_cache:
         cache.disable()
+        os.environ[cache.ENV_VAR] = "off"  # and in the worker processes a batch starts
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:

@@ -260,3 +260,26 @@ def test_a_plot_without_matplotlib_names_the_extra_before_any_decay(capsys, monk
     monkeypatch.setattr(builtins, "__import__", no_matplotlib)
     status, _, err = run(capsys, "lifetime", "--perigee", 300, "--apogee", 300, "--plot", tmp_path / "p.png")
     assert status == 2 and err == "orbit-env: error: --plot needs matplotlib: pip install 'orbit-env[plot]'\n"
+
+
+def test_a_dated_batch_with_bands_keeps_the_nominal_dates(capsys, tmp_path):
+    sats = tmp_path / "sats.csv"
+    sats.write_text("name,perigee_km,apogee_km,mass_kg,area_m2,cx\na,300,350,4,0.03,2.2\n")
+    plain, banded = tmp_path / "plain.csv", tmp_path / "banded.csv"
+    common = ["--batch", sats, "--epoch", "2024-01-01", "--inclination", 51.6, "--no-progress"]
+    assert run(capsys, "lifetime", *common, "--out", plain)[0] == 0
+    argv = [*common, "--out", banded, "--uncertainty", "--samples", 20, "--workers", 1]
+    assert run(capsys, "lifetime", *argv)[0] == 0
+    (nominal,) = csv.DictReader(open(plain, newline=""))
+    (row,) = csv.DictReader(open(banded, newline=""))
+    assert row["epoch"] == nominal["epoch"] == "2024-01-01T00:00Z" and row["reentry_date"] == nominal["reentry_date"]
+    assert row["reentry_date_p50"] != ""
+
+
+def test_a_batch_of_named_sets_keeps_their_catalogue_numbers(capsys, tmp_path):
+    named = tmp_path / "named.tle"
+    named.write_text("BEESAT 4\n" + last_lines(SETS / "41619_beesat4.tle", 2))
+    out = tmp_path / "out.csv"
+    assert run(capsys, "lifetime", "--batch", named, "--out", out, "--no-progress")[0] == 0
+    (row,) = csv.DictReader(open(out, newline=""))
+    assert (row["name"], row["id"]) == ("BEESAT 4", "41619")
