@@ -118,6 +118,17 @@ def _drag_parameter(row: dict[str, str], default_cx: float, default_c: float) ->
     c = _bounded(row, "drag_parameter_m2_kg", "m^2/kg", DRAG_PARAMETER_RANGE_M2_KG)
     load = _bounded(row, "mass_per_area_kg_m2", "kg/m^2", MASS_PER_AREA_RANGE_KG_M2)
     mass, area = _bounded(row, "mass_kg", "kg", MASS_RANGE_KG), _bounded(row, "area_m2", "m^2", AREA_RANGE_M2)
+    given = [
+        name
+        for name, present in (
+            ("drag_parameter_m2_kg", c is not None),
+            ("mass_per_area_kg_m2", load is not None),
+            ("mass_kg and area_m2", mass is not None or area is not None),
+        )
+        if present
+    ]
+    if len(given) > 1:  # alternatives: which one a row means is not for the batch to guess
+        raise ValueError(f"the satellite is given twice ({'; '.join(given)}): give one of them")
     if c is not None:
         value = c
     elif load is not None:

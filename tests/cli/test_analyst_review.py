@@ -283,3 +283,18 @@ def test_a_batch_of_named_sets_keeps_their_catalogue_numbers(capsys, tmp_path):
     assert run(capsys, "lifetime", "--batch", named, "--out", out, "--no-progress")[0] == 0
     (row,) = csv.DictReader(open(out, newline=""))
     assert (row["name"], row["id"]) == ("BEESAT 4", "41619")
+
+
+def test_a_row_that_gives_its_satellite_twice_is_not_guessed(capsys, tmp_path):
+    sats = tmp_path / "two.csv"
+    sats.write_text(
+        "name,perigee_km,apogee_km,mass_per_area_kg_m2,drag_parameter_m2_kg,mass_kg,area_m2\n"
+        "d,400,400,100,0.02,,\ne,400,400,,0.02,5,0.05\nok,400,400,,0.02,,\n"
+    )
+    out = tmp_path / "out.csv"
+    assert run(capsys, "lifetime", "--batch", sats, "--out", out, "--no-progress")[0] == 1
+    rows = {r["name"]: r["status"] for r in csv.DictReader(open(out, newline=""))}
+    twice = "the satellite is given twice"
+    assert rows["d"] == f"line 2: {twice} (drag_parameter_m2_kg; mass_per_area_kg_m2): give one of them"
+    assert rows["e"] == f"line 3: {twice} (drag_parameter_m2_kg; mass_kg and area_m2): give one of them"
+    assert rows["ok"] == "ok"
