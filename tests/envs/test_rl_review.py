@@ -84,8 +84,8 @@ def test_a_model_trained_with_env_settings_is_named_as_such(tmp_path):
     ]
 
 
-def test_sweeps_and_curves_refuse_a_seed_counted_twice_and_a_folder_of_other_settings(tmp_path):
-    pytest.importorskip("ray")
+def test_sweeps_and_curves_refuse_a_seed_counted_twice(tmp_path):
+    # Checked before Ray is imported: without the cluster extra the error is this one, not an ImportError.
     from orbit_env.agents.curves import curves
     from orbit_env.agents.sweep import sweep
 
@@ -93,6 +93,12 @@ def test_sweeps_and_curves_refuse_a_seed_counted_twice_and_a_folder_of_other_set
         sweep("OrbitRaising-v0", ["a2c", "a2c"], 1, 64, tmp_path / "s", episodes=5, include_dp=False)
     with pytest.raises(ValueError, match="algorithms ppo given twice"):
         curves("OrbitRaising-v0", ["ppo", "ppo"], 1, 64, 64, tmp_path / "c")
+
+
+def test_a_sweep_refuses_a_folder_of_other_or_unrecorded_settings(tmp_path):
+    pytest.importorskip("ray")
+    from orbit_env.agents.sweep import sweep
+
     legacy = tmp_path / "legacy"
     (legacy / "ray" / "sweep").mkdir(parents=True)  # a sweep from before the settings were recorded
     with pytest.raises(ValueError, match="holds a sweep that does not record its settings"):
