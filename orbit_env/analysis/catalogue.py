@@ -200,6 +200,17 @@ def _store_check(
     complies[rows], new_hp[rows], dv[rows] = check.complies, check.new_perigee_m, check.dv_m_s
 
 
+def row_start_days(orbits: Any, scenario: Scenario, own_epochs: bool) -> FloatArray | None:
+    """`batch_lifetimes`'s ``epoch_days`` of a batch: each row's start, or None for an undated batch.
+
+    Each row's own epoch with ``own_epochs`` (a batch of element sets), else the scenario's for every row
+    when it is dated (its rows then gain the nominal dates).
+    """
+    if own_epochs:
+        return orbits.epoch_days
+    return None if scenario.epoch_days is None else np.full(len(orbits.rows), scenario.epoch_days)
+
+
 def batch_lifetimes(
     rows: Sequence[dict[str, str]],
     perigee_m: FloatArray,

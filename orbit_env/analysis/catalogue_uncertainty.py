@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from orbit_env.analysis.catalogue import batch_lifetimes
+from orbit_env.analysis.catalogue import batch_lifetimes, row_start_days
 from orbit_env.analysis.catalogue_io import BatchOrbits, format_value
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.analysis.uncertainty import PERCENTILES, lifetime_spread, spread_report
@@ -84,7 +84,7 @@ def uncertain_lifetimes(
         progress=False,
         exact_groups=True,
         # Dated: the nominal re-entry's epoch and date columns, as a batch without bands has them.
-        epoch_days=orbits.epoch_days if own_epochs else _common_epochs(len(orbits.rows), scenario),
+        epoch_days=row_start_days(orbits, scenario, own_epochs),
     )
     for i, record in enumerate(records):
         status = record.pop("status")
@@ -99,11 +99,6 @@ def uncertain_lifetimes(
             columns.update(_row_columns(orbits, i, air, samples, seed, rule_years, dated))
         record.update(columns, status=status)
     return records
-
-
-def _common_epochs(n: int, scenario: Scenario) -> Any:
-    """Every row's start, the scenario's epoch, in a dated batch of one date (None undated)."""
-    return None if scenario.epoch_days is None else np.full(n, scenario.epoch_days)
 
 
 def _row_columns(

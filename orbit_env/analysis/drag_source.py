@@ -305,9 +305,10 @@ def element_set_orbits(
     unread = {}  # catalogue number -> the first set of it that could not be read
     for bad in bad_sets:
         unread.setdefault(bad.catalogue_number, bad)
+    only_unread = [(number, bad) for number, bad in unread.items() if number not in histories]
     # The catalogue number is the row's id (a name line would otherwise hide it).
     rows = [{"name": s.name, "id": s.catalogue_number} for s in latest]
-    rows += [{"name": bad.name or number, "id": number} for number, bad in unread.items() if number not in histories]
+    rows += [{"name": bad.name or number, "id": number} for number, bad in only_unread]
     n = len(rows)
     hp = np.full(n, np.nan)
     ha = np.full(n, np.nan)
@@ -319,7 +320,7 @@ def element_set_orbits(
     epochs[: len(latest)] = [s.epoch_days for s in latest]
     c = np.full(n, satellite.drag_parameter_m2_kg)
     sigma = np.full(n, np.nan)
-    status = ["ok"] * len(latest) + [f"{bad.message}" for number, bad in unread.items() if number not in histories]
+    status = ["ok"] * len(latest) + [bad.message for _, bad in only_unread]
     source = [SOURCE_SATELLITE] * n
     for i, (s, history) in enumerate(zip(latest, objects, strict=True)):
         if s.catalogue_number in unread:

@@ -269,22 +269,10 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     return 0
 
 
-def _batch_epochs(args: argparse.Namespace, orbits: Any, scenario: Scenario) -> Any:
-    """Each row's start [unix days] in a dated batch (its object's latest set, or --epoch), None undated.
-
-    Given, the results gain the ``epoch`` and ``reentry_date`` columns a dated lifetime prints.
-    """
-    if getattr(args, "rows_own_epochs", False):
-        return orbits.epoch_days
-    if scenario.epoch_days is not None:
-        return np.full(len(orbits.rows), scenario.epoch_days)
-    return None
-
-
 def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Scenario) -> int:
     from concurrent.futures.process import BrokenProcessPool
 
-    from orbit_env.analysis.catalogue import batch_lifetimes
+    from orbit_env.analysis.catalogue import batch_lifetimes, row_start_days
     from orbit_env.analysis.catalogue_io import write_records
     from orbit_env.analysis.catalogue_parts import parts_folder
 
@@ -324,7 +312,7 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             air,
             rule_years=args.rule,
             progress=not args.no_progress,
-            epoch_days=_batch_epochs(args, orbits, scenario),
+            epoch_days=row_start_days(orbits, scenario, getattr(args, "rows_own_epochs", False)),
         )
         write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
         rows, ok = summary.rows, summary.ok
