@@ -35,7 +35,8 @@ from numpy.typing import NDArray
 
 from orbit_env import cache
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
-from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2
+from orbit_env.physics.orbit import corotation_drag_factor
 from orbit_env.workers import in_two_processes
 
 FloatArray = NDArray[np.float64]
@@ -81,11 +82,10 @@ def _orbit(semi_major_axis_m: float, eccentricity: float) -> tuple[FloatArray, F
 
 
 def rotation_factor(perigee_radius_m: float, apogee_radius_m: float, inclination_deg: float) -> float:
-    """F_rot: drag against co-rotating air over drag against still air, at the perigee."""
-    a = 0.5 * (perigee_radius_m + apogee_radius_m)
-    v_p = math.sqrt(MU_EARTH_M3_S2 * (2.0 / perigee_radius_m - 1.0 / a))
-    wind = EARTH_ROTATION_RAD_S * perigee_radius_m * math.cos(math.radians(inclination_deg))
-    return ((v_p - wind) / v_p) ** 2
+    """F_rot of an orbit given by its radii (`orbit_env.physics.orbit.corotation_drag_factor`)."""
+    return float(
+        corotation_drag_factor(perigee_radius_m - EARTH_RADIUS_M, apogee_radius_m - EARTH_RADIUS_M, inclination_deg)
+    )
 
 
 @dataclass(frozen=True)

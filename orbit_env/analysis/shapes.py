@@ -18,9 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
 from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples, require_pymsis
 from orbit_env.physics.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
+from orbit_env.physics.orbit import air_speed_at_perigee_m_s, perigee_velocity_m_s
 
 #: Energy accommodation of the drag model (Sentman's diffuse, fully accommodated re-emission).
 ACCOMMODATION = 1.0
@@ -120,11 +120,12 @@ def drag_at_start(
     )
     rho, temperature = out[:, 0], out[:, 10]
     molecular_mass = rho / np.nansum(out[:, 1:10], axis=1)
-    radius_m = EARTH_RADIUS_M + height_m
-    speed = math.sqrt(MU_EARTH_M3_S2 / radius_m)
-    if rotating_atmosphere:
-        # The air's eastward speed projected on the track averages omega r cos i.
-        speed -= EARTH_ROTATION_RAD_S * radius_m * math.cos(math.radians(inclination_deg))
+    # A circular orbit's speed, through the co-rotating air if it turns (the wind along the track: omega r cos i).
+    speed = float(
+        air_speed_at_perigee_m_s(height_m, height_m, inclination_deg)
+        if rotating_atmosphere
+        else perigee_velocity_m_s(height_m, height_m)
+    )
     s = speed_ratio(speed, temperature, molecular_mass)
     cd = shape.drag_coefficient(s, WALL_TEMPERATURE_K / temperature, accommodation)
     weight = rho / rho.sum()

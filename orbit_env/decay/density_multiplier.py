@@ -27,11 +27,11 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S
 from orbit_env.decay.averaged import DecayModel, kernel_rates
 from orbit_env.decay.curves import UniversalCurves
 from orbit_env.physics.atmosphere.msis import ALTITUDE_GRID_M, MsisAtmosphere
-from orbit_env.physics.orbit import elements_from_heights, heights_from_elements
+from orbit_env.physics.orbit import air_speed_at_perigee_m_s, elements_from_heights, heights_from_elements
 
 FloatArray = NDArray[np.float64]
 
@@ -204,11 +204,8 @@ def corotation_factor(
     the orbit at the perigee, where near-circular orbits meet most of their drag.
     ``inclination_deg`` broadcasts against the heights.
     """
-    p, e = elements_from_heights(perigee_m, apogee_m)
-    v_p = np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
-    wind = EARTH_ROTATION_RAD_S * (EARTH_RADIUS_M + perigee_m)
-    cos_i = np.cos(np.radians(np.asarray(inclination_deg, dtype=np.float64)))
-    return np.asarray(((v_p - wind * cos_i) / (v_p - wind * math.cos(math.radians(reference_deg)))) ** 2)
+    own = air_speed_at_perigee_m_s(perigee_m, apogee_m, inclination_deg)
+    return np.asarray((own / air_speed_at_perigee_m_s(perigee_m, apogee_m, reference_deg)) ** 2)
 
 
 def life_rate_ratio(

@@ -45,7 +45,7 @@ from orbit_env.constants import (
     TWO_PI,
 )
 from orbit_env.physics.atmosphere import Atmosphere, as_atmosphere
-from orbit_env.physics.orbit import elements_from_heights, period_s, validate_heights
+from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights
 
 FloatArray = NDArray[np.float64]
 
@@ -171,9 +171,8 @@ def initial_state(perigee_m: float, apogee_m: float, inclination_deg: float = 0.
     The position is on +x and the velocity in the plane through x inclined by i
     to the equator (x-y plane), so i < 90 deg is prograde (east-going).
     """
-    p_m, e = (float(v) for v in elements_from_heights(perigee_m, apogee_m))
     r_m = EARTH_RADIUS_M + perigee_m
-    v_m_s = math.sqrt(MU_EARTH_M3_S2 / p_m) * (1.0 + e)
+    v_m_s = float(perigee_velocity_m_s(perigee_m, apogee_m))
     inclination_rad = math.radians(inclination_deg)
     return np.array([r_m, 0.0, 0.0, 0.0, v_m_s * math.cos(inclination_rad), v_m_s * math.sin(inclination_rad), 0.0])
 

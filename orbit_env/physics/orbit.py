@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_array
-from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, TWO_PI
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M, TWO_PI
 
 FloatArray = NDArray[np.float64]
 
@@ -93,6 +93,27 @@ def perigee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArra
     """Speed at perigee, v_pi = sqrt(fM) (1 + e) / sqrt(p) (section 3) [m/s]."""
     p, e = elements_from_heights(perigee_m, apogee_m)
     return np.sqrt(MU_EARTH_M3_S2 / p) * (1.0 + e)
+
+
+def air_speed_at_perigee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, inclination_deg: ArrayLike) -> FloatArray:
+    """Speed at perigee through air co-rotating with the Earth [m/s]: v_pi - Omega r_p cos i.
+
+    The air's eastward speed Omega r cos(latitude), projected on a track of inclination i
+    (whose eastward share at that latitude is cos i / cos(latitude)), is Omega r cos i at any
+    latitude. ``inclination_deg`` broadcasts against the heights.
+    """
+    wind = EARTH_ROTATION_RAD_S * np.add(perigee_m, EARTH_RADIUS_M)
+    return perigee_velocity_m_s(perigee_m, apogee_m) - wind * np.cos(np.radians(inclination_deg))
+
+
+def corotation_drag_factor(perigee_m: ArrayLike, apogee_m: ArrayLike, inclination_deg: ArrayLike) -> FloatArray:
+    """F_rot: drag in co-rotating air over drag in still air, (v_air / v_pi)^2 (`air_speed_at_perigee_m_s`).
+
+    At the perigee, where near-circular orbits meet most of their drag: 0.875 at 0 deg for a 400 km
+    circle, 1 at 90 deg, above 1 on retrograde orbits.
+    """
+    v_pi = perigee_velocity_m_s(perigee_m, apogee_m)
+    return (air_speed_at_perigee_m_s(perigee_m, apogee_m, inclination_deg) / v_pi) ** 2
 
 
 def apogee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:

@@ -5,9 +5,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from orbit_env.constants import EARTH_RADIUS_M, EARTH_ROTATION_RAD_S
 from orbit_env.paper.table2 import load_table2
 from orbit_env.physics.orbit import (
+    air_speed_at_perigee_m_s,
     apogee_after_perigee_burn_m,
+    corotation_drag_factor,
     dv_for_apogee_m_s,
     elements_from_heights,
     escape_dv_m_s,
@@ -104,3 +107,24 @@ def test_a_burn_to_escape_has_an_unbounded_apogee():
     escape = float(escape_dv_m_s(300e3, 500e3))
     assert apogee_after_perigee_burn_m(300e3, 500e3, escape * 0.999) < 1e11  # still bound: 1.2e10 m
     assert apogee_after_perigee_burn_m(300e3, 500e3, escape * 1.001) > 1e299  # not the old apogee
+
+
+@pytest.mark.parametrize("inclination_deg", [0.0, 28.5, 51.6, 97.5, 180.0])
+def test_the_air_along_the_track_is_omega_r_cos_i_at_every_latitude(inclination_deg):
+    """v_pi - Omega r cos i is the along-track speed through co-rotating air, wherever the perigee lies.
+
+    Independently, with vectors: a circular orbit of inclination i, the satellite at argument of
+    latitude u; the air's velocity Omega z x r; the relative velocity projected on the track.
+    Exact up to rounding (1e-9 m/s).
+    """
+    h = 400e3
+    r = EARTH_RADIUS_M + h
+    v = float(perigee_velocity_m_s(h, h))
+    i = np.radians(inclination_deg)
+    for u in np.linspace(0.0, 2.0 * np.pi, 13):
+        position = r * np.array([np.cos(u), np.sin(u) * np.cos(i), np.sin(u) * np.sin(i)])
+        along = np.array([-np.sin(u), np.cos(u) * np.cos(i), np.cos(u) * np.sin(i)])
+        air = np.cross([0.0, 0.0, EARTH_ROTATION_RAD_S], position)
+        relative_along = float(np.dot(v * along - air, along))
+        assert float(air_speed_at_perigee_m_s(h, h, inclination_deg)) == pytest.approx(relative_along, abs=1e-9)
+    assert float(corotation_drag_factor(h, h, inclination_deg)) == pytest.approx((relative_along / v) ** 2, rel=1e-12)
