@@ -1,7 +1,9 @@
 """Agents for the orbit-raising environments: hand-coded baselines, the DP optimum and PPO.
 
 Every agent answers Stable-Baselines3's ``predict(obs, state=None, episode_start=None,
-deterministic=True) -> (action, state)``, so one evaluation scores them all.
+deterministic=True) -> (action, state)`` (`orbit_env.agents.protocol`), so one evaluation scores them
+all; but the solar task's optimum, a DP per mission that knows the mission's Sun to come, which acts
+on the task's states (`orbit_env.agents.solar_dp`).
 """
 
 #: Default seed of the evaluation episodes (training uses 0). Here, not in `orbit_env.agents.evaluate`

@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, task_of
-from orbit_env.envs import SOLAR_ENV_IDS
+from orbit_env.envs import SOLAR_ENV_IDS, SOLAR_EVAL_SPLIT
 
 FloatArray = NDArray[np.float64]
 
@@ -362,7 +362,7 @@ def certify(
     start_time = time.perf_counter()
     say("dp (solving and playing)")
     if env_id in SOLAR_ENV_IDS:
-        solar = {"solar_split": "test", **(env_kwargs or {})}
+        solar = {"solar_split": SOLAR_EVAL_SPLIT, **(env_kwargs or {})}
         optimum = _solar_optimum(env_id, episodes, seed, solar, workers, say, rollout=dp_rollout)
     else:
         optimum = _known_density_optimum(env_id, episodes, seed, policy, dp_lookahead, dp_rollout)

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from scipy.optimize import brentq
 
 from orbit_env import cache
+from orbit_env.agents.protocol import Predicts
 from orbit_env.agents.stage_values import StageValues
 from orbit_env.decay.curves import (
     CURVES_MAX_APOGEE_M,
@@ -754,7 +755,7 @@ def rollout_returns(
     return total
 
 
-class DPPolicy:
+class DPPolicy(Predicts):
     """The optimum's policy, in Stable-Baselines3's ``predict`` protocol.
 
     It recovers the state from the observation (heights, delta-v left -> mass by
@@ -855,17 +856,7 @@ class DPPolicy:
         better = first[every, best] > value + ROLLOUT_TIE_DAYS
         return np.where(better, sizes[best], base_m_s)
 
-    def predict(
-        self,
-        observation: Any,
-        state: Any = None,
-        episode_start: Any = None,
-        deterministic: bool = True,
-    ) -> tuple[Any, Any]:
-        """Actions for one observation (7,) or a batch (n, 7); SB3's signature.
-
-        The index of the config's burn size chosen (`burns_m_s`).
-        """
+    def actions_of(self, observation: Any) -> NDArray[np.int64]:
+        """The index of the config's burn size chosen (`burns_m_s`) for observations (7,) or (n, 7): (n,)."""
         burns = self.burns_m_s(observation)
-        actions = np.abs(burns[:, None] - np.asarray(self.config.burn_sizes_m_s)).argmin(axis=1).astype(np.int64)
-        return (actions[0] if np.ndim(observation) == 1 else actions), state
+        return np.abs(burns[:, None] - np.asarray(self.config.burn_sizes_m_s)).argmin(axis=1).astype(np.int64)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
@@ -154,15 +154,24 @@ def run_episodes(
     return Episodes(returns=returns, lifetime_days=days, dv_m_s=dv)
 
 
+def capture(mean_return: float, never_return: float | None, dp_return: float | None) -> float | None:
+    """(R - R_never) / (R_dp - R_never): the share of the optimum's improvement over never burning.
+
+    None without both references, or where never burning is optimal (no improvement to share).
+    """
+    if never_return is None or dp_return is None or abs(dp_return - never_return) < 1e-9:
+        return None
+    return float((mean_return - never_return) / (dp_return - never_return))
+
+
 def summarize(results: Mapping[str, Episodes]) -> dict[str, dict[str, float | None]]:
-    """Per-policy summary with capture = (R - R_never) / (R_dp - R_never)."""
+    """Per-policy summary with its `capture`."""
     table: dict[str, dict[str, float | None]] = {}
-    never = results["never"].returns.mean() if "never" in results else None
-    best = results["dp"].returns.mean() if "dp" in results else None
+    never = float(results["never"].returns.mean()) if "never" in results else None
+    best = float(results["dp"].returns.mean()) if "dp" in results else None
     for name, result in results.items():
         row: dict[str, float | None] = dict(result.summary())
-        gain = None if never is None or best is None else best - never
-        row["capture"] = None if gain is None or abs(gain) < 1e-9 else float((result.returns.mean() - never) / gain)
+        row["capture"] = capture(float(result.returns.mean()), never, best)
         table[name] = row
     return table
 
@@ -224,6 +233,11 @@ def paired_difference(
     }
 
 
+def policy_width(names: Iterable[str]) -> int:
+    """Width of a table's policy column: 17 characters, or the longest name's."""
+    return max([17, *(len(name) for name in names)])
+
+
 def format_table(
     env_id: str,
     episodes: int,
@@ -232,14 +246,15 @@ def format_table(
     paired: Sequence[Mapping[str, Any]] = (),
 ) -> str:
     """The evaluation as a text table for people (``paired``: results of `paired_difference`)."""
+    width = policy_width(table)
     lines = [
         f"{env_id}: {episodes} episodes (seed {seed})",
-        f"{'policy':<17} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
+        f"{'policy':<{width}} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
     ]
     for name, row in table.items():
         capture = "" if row["capture"] is None else f"{row['capture']:8.1%}"
         lines.append(
-            f"{name:<17} {row['mean_return']:8.1f} +- {row['std_return']:5.1f} {row['mean_lifetime_days']:13.1f} "
+            f"{name:<{width}} {row['mean_return']:8.1f} +- {row['std_return']:5.1f} {row['mean_lifetime_days']:13.1f} "
             f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
         )
     if any(row["capture"] is not None for row in table.values()):

@@ -48,6 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.agents.dp import DPPolicy
+from orbit_env.agents.protocol import Predicts
 from orbit_env.envs import task as task_model
 from orbit_env.envs.state import BatchState
 
@@ -87,7 +88,7 @@ def _features(states: BatchState) -> FloatArray:
     return np.stack([states.perigee_m, states.apogee_m, states.dv_left_m_s], axis=-1)
 
 
-class PlanPolicy:
+class PlanPolicy(Predicts):
     """Open-loop plans refined from the DP policy's (see the module); SB3's ``predict`` protocol.
 
     Args:
@@ -142,16 +143,9 @@ class PlanPolicy:
             burns[new] = plans.burns[:, 0]
         return burns
 
-    def predict(
-        self,
-        observation: Any,
-        state: Any = None,
-        episode_start: Any = None,
-        deterministic: bool = True,
-    ) -> tuple[Any, Any]:
-        """Box actions a = burn / max burn for one observation (7,) or a batch (n, 7); SB3's signature."""
-        actions = self._acting.encode(self.burns_m_s(observation))
-        return (actions[0] if np.ndim(observation) == 1 else actions), state
+    def actions_of(self, observation: Any) -> Any:
+        """Box actions a = burn / max burn for observations (7,) or (n, 7): (n, 1)."""
+        return self._acting.encode(self.burns_m_s(observation))
 
     def _lookup(self, features: FloatArray, steps: NDArray[np.intp]) -> tuple[NDArray[np.bool_], FloatArray]:
         """The burn of the plan whose track each state follows (newest plans first), and which were found."""

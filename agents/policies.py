@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.agents.protocol import Predicts
 from orbit_env.decay.curves import CURVES_MAX_APOGEE_M
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import DensityConfig, OrbitRaisingConfig
@@ -25,7 +26,7 @@ from orbit_env.physics.orbit import dv_for_apogee_m_s
 FloatArray = NDArray[np.float64]
 
 
-class BurnPolicy:
+class BurnPolicy(Predicts):
     """Shared plumbing: decode observations into planning states, encode burns as actions.
 
     Args:
@@ -51,16 +52,9 @@ class BurnPolicy:
         """The burn each satellite asks for [m/s] (subclasses)."""
         raise NotImplementedError
 
-    def predict(
-        self,
-        observation: Any,
-        state: Any = None,
-        episode_start: Any = None,
-        deterministic: bool = True,
-    ) -> tuple[Any, Any]:
-        """Actions for one observation (7,) or a batch (n, 7); SB3's signature."""
-        actions = self.task.encode(self.burns_m_s(task_model.decode(self.task, observation)))
-        return (actions[0] if np.ndim(observation) == 1 else actions), state
+    def actions_of(self, observation: Any) -> Any:
+        """Actions for observations (7,) or (n, 7): the burns' sizes' indices, or Box values (n, 1)."""
+        return self.task.encode(self.burns_m_s(task_model.decode(self.task, observation)))
 
 
 class NeverBurn(BurnPolicy):

@@ -1,11 +1,13 @@
 """Yardsticks of the solar task (``OrbitRaisingSolar-v0``): operators' rules, the optimum, the evaluation.
 
 Hand-coded operators' rules act on the observation alone, as an operator would
-(`SOLAR_HAND_CODED`): never burn; burn the whole tank at once; reboost when the perigee falls
-below a threshold; reboost when the predicted lifetime falls below a share of the mission's
-time left; the greedy look-ahead on the observed activity held constant. The two thresholds
-are tuned on the train split (`tune`), never on the test split. The optimum is the per-episode
-DP (`orbit_env.agents.solar_dp`), which knows the Sun's future.
+(`SOLAR_RULES`, in the order of the rows): never burn; burn the whole tank at once; reboost
+when the perigee falls below a threshold; reboost when the predicted lifetime falls below a
+share of the mission's time left; the greedy look-ahead on the observed activity held constant.
+A rule with a ``grid`` has its threshold (and the reserve it keeps) tuned on the train split
+(`tune`), never on the test split. Each answers SB3's ``predict`` as well as ``actions``. A new
+rule is a class here and its entry in `SOLAR_RULES`. The optimum is the per-episode DP
+(`orbit_env.agents.solar_dp`), which knows the Sun's future.
 
 `evaluate_solar` scores them all on the same missions (drawn once from a seed; the DP's
 episodes solved and flown in worker processes), with any learned agent (`by_model`: the shipped
@@ -27,12 +29,13 @@ from numpy.typing import NDArray
 
 from orbit_env.agents import VALIDATION_SEED
 from orbit_env.agents.evaluate import Episodes, predicted_actions
+from orbit_env.agents.protocol import Predicts
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
-from orbit_env.envs import SOLAR_ENV_ID, solar_task
+from orbit_env.envs import DISPOSAL_YEARS, SOLAR_ENV_ID, SOLAR_EVAL_SPLIT, solar_task
 from orbit_env.envs import task as task_model
-from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SolarMission, SolarStep, SolarTask
+from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SOLAR_OBS_NAMES, SolarMission, SolarStep, SolarTask
 from orbit_env.envs.state import BatchState
-from orbit_env.envs.task import DV_SCALE_M_S, HEIGHT_SCALE_M, LIFETIME_SCALE_DAYS
+from orbit_env.envs.task import DV_SCALE_M_S, HEIGHT_SCALE_M, observation_batch
 from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
 
 FloatArray = NDArray[np.float64]
@@ -59,8 +62,16 @@ def _column(obs: FloatArray, name: str) -> FloatArray:
     return np.asarray(obs, dtype=np.float64)[:, SOLAR_OBS_INDEX[name]]
 
 
-class Never:
-    """Never burn (the disposal burn at the end is the environment's)."""
+class Never(Predicts):
+    """Never burn (the disposal burn at the end is the environment's).
+
+    The base of the operators' rules: a rule's ``actions`` maps observations (n, 11) to burn
+    sizes' indices; ``predict`` answers SB3's protocol with them, in either solar id's action
+    space. ``name`` is the rule's row; ``grid``, where not None, the thresholds `tune` tries.
+    """
+
+    name = "never"
+    grid: tuple[float, ...] | None = None
 
     def __init__(self, task: SolarTask) -> None:
         self.task = task
@@ -69,56 +80,65 @@ class Never:
         """Action 0 for every observation."""
         return np.zeros(len(obs), dtype=np.int64)
 
+    def actions_of(self, observation: Any) -> Any:
+        """`actions` of observations (11,) or (n, 11) in the environment's action space (SB3's ``predict``).
+
+        The burn sizes' indices, or on the continuous twin the Box values that burn the same sizes.
+
+        Raises:
+            ValueError: an observation of another shape, or not finite.
+        """
+        obs = observation_batch(observation, len(SOLAR_OBS_NAMES))
+        burns = np.asarray(self.task.config.burn_sizes_m_s, dtype=np.float64)[self.actions(obs)]
+        return self.task.encode(burns)
+
 
 class AllAtOnce(Never):
     """The largest burn at every step from the start until the tank is empty."""
+
+    name = "all_at_once"
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn size for every observation."""
         return np.full(len(obs), _largest(self.task), dtype=np.int64)
 
 
-class PerigeeThreshold(Never):
-    """Reboost (the largest burn) when the perigee is below a threshold, keeping a reserve for the disposal."""
+class Threshold(Never):
+    """A reboost rule: the largest burn when a measure falls below ``threshold``, keeping ``reserve_m_s`` [m/s]."""
 
-    def __init__(self, task: SolarTask, threshold_km: float, reserve_m_s: float) -> None:
+    def __init__(self, task: SolarTask, threshold: float, reserve_m_s: float) -> None:
         super().__init__(task)
-        self.threshold_km, self.reserve_m_s = threshold_km, reserve_m_s
+        self.threshold, self.reserve_m_s = threshold, reserve_m_s
+
+    def _spare(self, obs: FloatArray) -> NDArray[np.bool_]:
+        """Where the tank holds more than the reserve."""
+        return _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
+
+
+class PerigeeThreshold(Threshold):
+    """Reboost when the perigee is below ``threshold`` [km], keeping a reserve for the disposal."""
+
+    name = "perigee_threshold"
+    grid = PERIGEE_THRESHOLDS_KM
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn where the perigee is low and the tank holds more than the reserve."""
-        low = _column(obs, "perigee") * HEIGHT_SCALE_M < self.threshold_km * 1e3
-        spare = _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
-        return np.where(low & spare, _largest(self.task), 0).astype(np.int64)
+        low = _column(obs, "perigee") * HEIGHT_SCALE_M < self.threshold * 1e3
+        return np.where(low & self._spare(obs), _largest(self.task), 0).astype(np.int64)
 
 
-class LifeThreshold(PerigeeThreshold):
-    """Reboost when the predicted lifetime is below ``share`` x the mission's time left, keeping a reserve."""
+class LifeThreshold(Threshold):
+    """Reboost when the predicted lifetime is below ``threshold`` x the mission's time left, keeping a reserve."""
+
+    name = "life_threshold"
+    grid = LIFE_SHARES
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn where the predicted life is short of the time left and the tank holds the reserve."""
-        x = np.clip(_column(obs, "predicted_lifetime"), 0.0, 1.0 - 1e-9)
-        life_days = LIFETIME_SCALE_DAYS * x / (1.0 - x)
+        life_days = solar_task.predicted_life_days(_column(obs, "predicted_lifetime"))
         left_days = (1.0 - _column(obs, "mission_clock")) * self.task.mission_days
-        short = life_days < self.threshold_km * left_days  # threshold_km holds the share
-        spare = _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
-        return np.where(short & spare & (left_days > 0.0), _largest(self.task), 0).astype(np.int64)
-
-
-def decode(task: SolarTask, obs: FloatArray) -> BatchState:
-    """The states a ground station recovers from observations: orbit, tank, steps, last month's multiplier."""
-    obs = np.atleast_2d(np.asarray(obs, dtype=np.float64))
-    perigee = np.clip(_column(obs, "perigee") * HEIGHT_SCALE_M, REENTRY_ALTITUDE_M, None)
-    apogee = np.maximum(_column(obs, "apogee") * HEIGHT_SCALE_M, perigee)
-    dv_left = np.maximum(_column(obs, "delta_v_left") * DV_SCALE_M_S, 0.0)
-    steps = np.rint(_column(obs, "mission_clock") * task.config.horizon_steps)
-    label, tau = task.curves.locate_exactly(perigee, apogee)
-    state = task_model.states_on_curves(task, label, tau, dv_left, steps)
-    x = np.clip(_column(obs, "predicted_lifetime"), 1e-9, 1.0 - 1e-9)
-    life_days = LIFETIME_SCALE_DAYS * x / (1.0 - x)
-    gc = solar_task.drag_rate(state)
-    state.density_scale = state.period_s * state.nu / (gc * life_days * SECONDS_PER_DAY)
-    return state
+        short = life_days < self.threshold * left_days
+        return np.where(short & self._spare(obs) & (left_days > 0.0), _largest(self.task), 0).astype(np.int64)
 
 
 class GreedyConstant(Never):
@@ -129,10 +149,12 @@ class GreedyConstant(Never):
     same multiplier (or the penalty if the tank could not pay it).
     """
 
+    name = "greedy_constant"
+
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The burn with the best look-ahead value."""
         task = self.task
-        state = decode(task, obs)
+        state = solar_task.decode(task, obs)
         left_days = (task.config.horizon_steps - state.steps) * task.mission.block_days
         cost = task.config.propellant_cost_per_m_s
         best = np.full(state.size, -np.inf)
@@ -301,16 +323,15 @@ def _tune(config: Any, mission: SolarMission) -> dict[str, tuple[float, float]]:
     train = SolarTask(config=config, mission=mission)
     options = starts(train, TUNE_EPISODES, TUNE_SEED)
     best: dict[str, tuple[float, float]] = {}
-    for name, cls, grid in (
-        ("perigee_threshold", PerigeeThreshold, PERIGEE_THRESHOLDS_KM),
-        ("life_threshold", LifeThreshold, LIFE_SHARES),
-    ):
+    for rule in SOLAR_RULES:
+        if rule.grid is None:
+            continue
         scores = {
-            (float(x), reserve): fly(train, options, by_observation(train, cls(train, x, reserve))).returns.mean()
-            for x in grid
+            (float(x), reserve): fly(train, options, by_observation(train, rule(train, x, reserve))).returns.mean()  # type: ignore[call-arg]
+            for x in rule.grid
             for reserve in RESERVES_M_S
         }
-        best[name] = max(scores, key=lambda key: scores[key])
+        best[rule.name] = max(scores, key=lambda key: scores[key])
     return best
 
 
@@ -319,19 +340,15 @@ def _with_split(mission: SolarMission, split: str) -> SolarMission:
 
 
 def hand_coded(task: SolarTask) -> dict[str, Never]:
-    """The operators' rules, the thresholds tuned on the train split (`tune`)."""
+    """The operators' rules by name, in `SOLAR_RULES`' order, the thresholds tuned on the train split (`tune`)."""
     tuned = tune(task)
-    return {
-        "never": Never(task),
-        "all_at_once": AllAtOnce(task),
-        "perigee_threshold": PerigeeThreshold(task, *tuned["perigee_threshold"]),
-        "life_threshold": LifeThreshold(task, *tuned["life_threshold"]),
-        "greedy_constant": GreedyConstant(task),
-    }
+    return {rule.name: rule(task) if rule.grid is None else rule(task, *tuned[rule.name]) for rule in SOLAR_RULES}  # type: ignore[call-arg]
 
 
-#: The order of the rows: the hand-coded rules, then the optimum.
-SOLAR_HAND_CODED = ("never", "all_at_once", "perigee_threshold", "life_threshold", "greedy_constant")
+#: The operators' rules in the order of the rows (the optimum's row follows them).
+SOLAR_RULES: tuple[type[Never], ...] = (Never, AllAtOnce, PerigeeThreshold, LifeThreshold, GreedyConstant)
+#: Their names.
+SOLAR_HAND_CODED = tuple(rule.name for rule in SOLAR_RULES)
 
 
 def map_missions(
@@ -389,8 +406,8 @@ def evaluate_solar(
     episodes: int,
     seed: int,
     *,
-    solar_split: str = "test",
-    disposal_years: float = 5.0,
+    solar_split: str = SOLAR_EVAL_SPLIT,
+    disposal_years: float = DISPOSAL_YEARS,
     include_dp: bool = True,
     dp_rollout: bool = False,
     workers: int | None = None,

@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from orbit_env.agents.solar import Flown, fly
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import unix_days
 from orbit_env.envs import solar_task
 from orbit_env.envs.solar_task import SolarStep, SolarTask
@@ -41,8 +42,6 @@ FloatArray = NDArray[np.float64]
 #: Minima of solar cycles 19-25 (SILSO, the 13-month smoothed sunspot number; month's middle day):
 #: the first day of each cycle, from which `years_since_minimum` counts.
 CYCLE_MINIMA = ("1954-04-15", "1964-10-15", "1976-03-15", "1986-09-15", "1996-08-15", "2008-12-15", "2019-12-15")
-#: Days of a year in `years_since_minimum`.
-YEAR_DAYS = 365.25
 #: Bin edges of the burn maps: perigee height [km]; the phases: years since the last minimum (to the
 #: longest cycle's length, `years_edges`), the observed 81-day F10.7 [sfu], and the mission's month.
 PERIGEE_EDGES_KM = np.arange(220.0, 561.0, 20.0)
@@ -169,7 +168,7 @@ def years_since_minimum(task: SolarTask, days: FloatArray) -> FloatArray:
     last = np.searchsorted(minima, days, side="right") - 1
     if np.any(last < 0):
         raise ValueError(f"days before the first minimum in CYCLE_MINIMA ({CYCLE_MINIMA[0]}) have no phase")
-    return (days - minima[last]) / YEAR_DAYS
+    return (days - minima[last]) / DAYS_PER_YEAR
 
 
 def f107_series(task: SolarTask, days: FloatArray) -> tuple[FloatArray, FloatArray]:

@@ -32,6 +32,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.envs import SOLAR_ENV_ID, SOLAR_EVAL_SPLIT
+
 #: The algorithms a sweep runs, and the action spaces each takes.
 SWEEP_ALGOS = {
     "ppo": ("discrete", "continuous"),
@@ -48,8 +50,6 @@ RECIPES = {
     "OrbitRaisingContinuous-v0": "ppo_continuous.toml",
     "OrbitRaisingSolar-v0": "ppo_solar.toml",
 }
-#: The split the solar task's trials are scored on: the held-out one of ``orbit-env evaluate``.
-SOLAR_EVAL_SPLIT = "test"
 #: Satellites stepped together in a trial with SB3's defaults.
 SWEEP_NUM_ENVS = 16
 #: Bootstrap resamples of the confidence intervals.
@@ -168,8 +168,6 @@ def score_model(env_id: str, model: Any, episodes: int, eval_seed: int) -> float
 
     The solar task flies the missions of the held-out `SOLAR_EVAL_SPLIT` (`orbit_env.agents.solar.fly_model`).
     """
-    from orbit_env.envs import SOLAR_ENV_ID
-
     if env_id == SOLAR_ENV_ID:
         from orbit_env.agents.solar import fly_model
 
@@ -180,9 +178,10 @@ def score_model(env_id: str, model: Any, episodes: int, eval_seed: int) -> float
 
 
 def capture_of(mean_return: float, references: dict[str, Any]) -> float | None:
-    """(R - R_never) / (R_dp - R_never); None without the DP's return (or when never is optimal)."""
-    never, dp = references.get("never_return"), references.get("dp_return")
-    return None if never is None or dp is None or abs(dp - never) < 1e-9 else (mean_return - never) / (dp - never)
+    """`orbit_env.agents.evaluate.capture` against a sweep's ``never_return`` and ``dp_return``."""
+    from orbit_env.agents.evaluate import capture
+
+    return capture(mean_return, references.get("never_return"), references.get("dp_return"))
 
 
 def run_trial(config: dict[str, Any]) -> dict[str, Any]:
@@ -214,7 +213,6 @@ def capture_references(
     the `SOLAR_EVAL_SPLIT` (``workers``: its processes solving the DPs; default: the cores).
     """
     from orbit_env.agents.evaluate import dp_policy, hand_coded_policies, run_episodes
-    from orbit_env.envs import SOLAR_ENV_ID
 
     if env_id == SOLAR_ENV_ID:
         from orbit_env.agents.solar import evaluate_solar
@@ -307,7 +305,7 @@ def sweep(
     import gymnasium
 
     from orbit_env.agents.evaluate import EVAL_SEED
-    from orbit_env.envs import ENV_IDS, SOLAR_ENV_ID
+    from orbit_env.envs import ENV_IDS
 
     allowed = (*ENV_IDS, SOLAR_ENV_ID)
     if env_id not in allowed:

@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.chunked import SolarDecayModel, cached_curves, propagate
 from orbit_env.decay.reference_path import integrate_reference
 from orbit_env.decay.solar import CycleActivity, TableActivity, unix_days
@@ -49,7 +50,7 @@ C_CUBESAT_M2_KG = 0.0165  # a 3U cubesat: c_x 2.2, 0.03 m^2, 4 kg
 def synthetic_table(start_days: float, years: float, seed: int = 7) -> TableActivity:
     """Rising solar cycle with a 27-day rotation and random geomagnetic storms (daily rows)."""
     rng = np.random.default_rng(seed)
-    days = start_days + np.arange(int(years * 365.25) + 100)
+    days = start_days + np.arange(int(years * DAYS_PER_YEAR) + 100)
     cycle = CycleActivity()
     _, f107a, _ = cycle.indices(days)
     f107 = f107a * (1.0 + 0.2 * np.sin(2 * np.pi * (days - days[0]) / 27.0))

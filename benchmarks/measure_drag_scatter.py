@@ -24,6 +24,7 @@ from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.drag_calibration import SOURCE_BSTAR_CALIBRATED, SOURCE_NDOT_CALIBRATED, calibrate
 from orbit_env.analysis.elements import read_tle
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import load_record
 
@@ -46,7 +47,7 @@ def main():
     diffs = {SOURCE_BSTAR_CALIBRATED: [], SOURCE_NDOT_CALIBRATED: []}
     for row, path in objects():
         reentry = unix_days(row["reentry_utc"].rstrip("Z")[:10])
-        sets = [s for s in read_tle(path) if 7.0 <= reentry - s.epoch_days <= 3 * 365.25]
+        sets = [s for s in read_tle(path) if 7.0 <= reentry - s.epoch_days <= 3 * DAYS_PER_YEAR]
         if len(sets) < 2:
             continue
         keep = np.unique(np.linspace(0, len(sets) - 1, min(len(sets), args.max_sets)).round().astype(int))

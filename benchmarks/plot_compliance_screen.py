@@ -17,6 +17,7 @@ import argparse
 import csv
 
 from orbit_env.analysis.uncertainty import RULE_CONFIDENCE
+from orbit_env.constants import DAYS_PER_YEAR
 
 
 def main() -> None:
@@ -37,7 +38,7 @@ def main() -> None:
     probability = [float(row["compliance_probability"]) for row in rows]
     passes = [row["complies_with_confidence"] == "true" for row in rows]
     years = {
-        p: [float(row[f"days_p{p}"]) / 365.25 if row[f"days_p{p}"] else float("nan") for row in rows]
+        p: [float(row[f"days_p{p}"]) / DAYS_PER_YEAR if row[f"days_p{p}"] else float("nan") for row in rows]
         for p in (5, 50, 95)
     }
     figure, (top, bottom) = plt.subplots(2, 1, figsize=(5.5, 5.0), sharex=True, dpi=90)

@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 from orbit_env.analysis.lifetime import Satellite, lifetime
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.lifetime_mean import mean_air_lifetime
 from orbit_env.decay.solar_record import load_record
@@ -44,7 +45,8 @@ def main() -> None:
             ratio = mean.days / stepped.days - 1.0
             ratios.append(ratio)
             print(
-                f"{epoch:<11} {hp_km:4.0f} x {ha_km:<7.0f} {stepped.days / 365.25:10.3f} {mean.days / 365.25:12.3f} "
+                f"{epoch:<11} {hp_km:4.0f} x {ha_km:<7.0f} {stepped.days / DAYS_PER_YEAR:10.3f} "
+                f"{mean.days / DAYS_PER_YEAR:12.3f} "
                 f"{ratio:+8.2%} {time.perf_counter() - start:8.1f}"
             )
     errors = np.abs(ratios)

@@ -40,6 +40,7 @@ import numpy as np
 from orbit_env.analysis.lifetime import Satellite, lifetime
 from orbit_env.analysis.shapes import ACCOMMODATION, Shape, drag_at_start, flown_nose_first, sphere
 from orbit_env.analysis.uncertainty import DENSITY_MODEL_SIGMA, DRAG_COEFFICIENT_SIGMA
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import SolarActivity, unix_days
 from orbit_env.decay.solar_record import load_record
 
@@ -192,7 +193,7 @@ class Row:
 
 def trend_scale(case: Case) -> float:
     """The density factor of the secular trend at the middle of the observed life, against 2005."""
-    middle_year = 1970.0 + 0.5 * (unix_days(case.start) + unix_days(case.reentry)) / 365.25
+    middle_year = 1970.0 + 0.5 * (unix_days(case.start) + unix_days(case.reentry)) / DAYS_PER_YEAR
     return (1.0 + TREND_PER_DECADE) ** ((middle_year - TREND_REFERENCE_YEAR) / 10.0)
 
 

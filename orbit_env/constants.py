@@ -26,5 +26,7 @@ EARTH_EQUATORIAL_RADIUS_M = 6.378137e6
 J2_EARTH = 1.08263e-3
 #: Seconds in a day.
 SECONDS_PER_DAY = 86400.0
+#: Days in a year (the Julian year): every lifetime given in years, every rule's years in days.
+DAYS_PER_YEAR = 365.25
 #: Two pi, named because it appears in every orbit average.
 TWO_PI = 2.0 * math.pi

@@ -33,6 +33,7 @@ from orbit_env.analysis.lifetime import (
     check_lifetime_days,
 )
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.constants import DAYS_PER_YEAR
 
 FloatArray = NDArray[np.float64]
 
@@ -257,7 +258,7 @@ def batch_lifetimes(
     else:
         group_of = np.zeros(n)
     groups = np.unique(group_of[ok])
-    cap_days = None if rule_years is None else (rule_years + 1.0) * 365.25
+    cap_days = None if rule_years is None else (rule_years + 1.0) * DAYS_PER_YEAR
     one_family = depends_on_inclination and not exact_groups and groups.size > MAX_FAMILIES
     by_groups = ok.copy()
     families: set[float] = set()
@@ -304,7 +305,7 @@ def batch_lifetimes(
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:
             status[i] = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"
-    for i in np.flatnonzero(ok & reentered & ~(days <= MAX_LIFETIME_YEARS * 365.25)):
+    for i in np.flatnonzero(ok & reentered & ~(days <= MAX_LIFETIME_YEARS * DAYS_PER_YEAR)):
         try:
             check_lifetime_days(float(days[i]))
         except ValueError as error:
@@ -323,7 +324,7 @@ def batch_lifetimes(
             record[DRAG_SOURCE_KEY] = row[DRAG_SOURCE_KEY]
         record.update(
             days=format_value(days[i]) if status[i] == "ok" and reentered[i] else "",
-            years=format_value(days[i] / 365.25) if status[i] == "ok" and reentered[i] else "",
+            years=format_value(days[i] / DAYS_PER_YEAR) if status[i] == "ok" and reentered[i] else "",
         )
         if rule_years is not None:
             good = status[i] == "ok"

@@ -43,7 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario
 from orbit_env.checks import InputError, check_date, check_number
-from orbit_env.constants import G0_M_S2, SECONDS_PER_DAY
+from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.decay.curves import NU_REF, UniversalCurves
 from orbit_env.decay.solar import unix_days
@@ -365,7 +365,7 @@ def _fit_orbits_time_varying(
             "give no --epoch (or the first observation's date)"
         )
     t = observations.days - start
-    model = replace(scenario.solar_model(inclination_deg, max_years=float(t[-1]) / 365.25 + 0.1), chunk_days=1.0)
+    model = replace(scenario.solar_model(inclination_deg, max_years=float(t[-1]) / DAYS_PER_YEAR + 0.1), chunk_days=1.0)
     observed = np.concatenate([hp, ha])
 
     def rss(log_scales: FloatArray) -> FloatArray:

@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_number
-from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2, REENTRY_ALTITUDE_M
+from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
+from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
 
 FloatArray = NDArray[np.float64]
 #: Lifetimes of many (perigee, apogee, satellite index) at once: (days, re-entered).
@@ -30,19 +31,6 @@ LifetimeFunction = Callable[[FloatArray, FloatArray, NDArray[np.intp]], tuple[Fl
 CANDIDATES = 16
 #: Passes of the search.
 PASSES = 3
-DAYS_PER_YEAR = 365.25
-
-
-def apogee_speed_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArray:
-    """Speed at apogee [m/s] (vis-viva)."""
-    rp = EARTH_RADIUS_M + np.asarray(perigee_m, dtype=np.float64)
-    ra = EARTH_RADIUS_M + np.asarray(apogee_m, dtype=np.float64)
-    return np.sqrt(2.0 * MU_EARTH_M3_S2 * rp / (ra * (ra + rp)))
-
-
-def perigee_lowering_dv_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, new_perigee_m: ArrayLike) -> FloatArray:
-    """Retrograde burn at apogee [m/s] that lowers the perigee to ``new_perigee_m``."""
-    return apogee_speed_m_s(perigee_m, apogee_m) - apogee_speed_m_s(new_perigee_m, apogee_m)
 
 
 @dataclass(frozen=True)
@@ -107,7 +95,7 @@ def check_disposal_rule(
         above = np.where(n_ok < CANDIDATES, candidates[np.arange(todo.size), np.minimum(n_ok, CANDIDATES - 1)], hi)
         lo, hi = below, above
     new_hp[todo] = lo
-    dv = np.where(complies, 0.0, perigee_lowering_dv_m_s(hp, ha, new_hp))
+    dv = np.where(complies, 0.0, dv_to_lower_perigee_m_s(hp, ha, new_hp))
     return RuleCheck(
         rule_years=float(rule_years),
         lifetime_days=days,

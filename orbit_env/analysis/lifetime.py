@@ -17,7 +17,7 @@ from orbit_env.analysis.air import Air, MsisAir, PaperAir, ProfileAir
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
 from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density
 from orbit_env.checks import InputError, check_date, check_number
-from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, SolarDecayModel, propagate
 from orbit_env.decay.curves import (
@@ -188,11 +188,11 @@ class LifetimeResult:
             "nu": self.nu,
             "revolutions": self.revolutions,
             "days": self.days if self.reentered else None,
-            "years": self.days / 365.25 if self.reentered else None,
+            "years": self.days / DAYS_PER_YEAR if self.reentered else None,
             "perigee_velocity_m_s": self.perigee_velocity_m_s,
             "method": self.method,
             "reentered": self.reentered,
-            **({} if self.reentered else {"years_reached": self.days / 365.25}),
+            **({} if self.reentered else {"years_reached": self.days / DAYS_PER_YEAR}),
             **({} if self.epoch_days is None else {"epoch": iso_datetime(self.epoch_days)}),
             **({} if self.reentry_date is None else {"reentry_date": self.reentry_date}),
         }
@@ -425,9 +425,9 @@ def check_lifetime_days(days: float) -> float:
     Raises:
         ValueError: ``days`` is not finite or exceeds `MAX_LIFETIME_YEARS`.
     """
-    if not (math.isfinite(days) and days <= MAX_LIFETIME_YEARS * 365.25):
+    if not (math.isfinite(days) and days <= MAX_LIFETIME_YEARS * DAYS_PER_YEAR):
         raise ValueError(
-            f"the lifetime comes out as {days / 365.25:.3g} years, more than {MAX_LIFETIME_YEARS:,.0f}: drag "
+            f"the lifetime comes out as {days / DAYS_PER_YEAR:.3g} years, more than {MAX_LIFETIME_YEARS:,.0f}: drag "
             "hardly touches this orbit, and no atmosphere model holds that long"
         )
     return days
@@ -468,7 +468,7 @@ def _lifetime_under_activity(
     elif method == "averaged":
         t, hp_path, ha_path = reference_path(hp_m, ha_m, c * scale, model)
         days = float(t[-1])
-        reentered = days < model.max_years * 365.25
+        reentered = days < model.max_years * DAYS_PER_YEAR
     else:
         result = propagate(hp_m, ha_m, c, model, density_scale=scale, record=True)
         days, reentered = float(result.days[0]), bool(result.reentered[0])
@@ -539,7 +539,7 @@ def check_rule(
 
     def lifetimes(hp: NDArray[np.float64], ha: NDArray[np.float64], which: NDArray[np.intp]) -> Any:
         # Called once check_disposal_rule has checked rule_years.
-        cap_days = (float(rule_years) + 1.0) * 365.25
+        cap_days = (float(rule_years) + 1.0) * DAYS_PER_YEAR
         return scenario.lifetime_days(hp, ha, np.full(hp.shape, c), inclination_deg, max_days=cap_days)
 
     return check_disposal_rule(hp_m, ha_m, rule_years, lifetimes)

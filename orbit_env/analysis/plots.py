@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from orbit_env.analysis.lifetime import LifetimeResult
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import SolarActivity
 from orbit_env.optional import pyplot
 
@@ -57,7 +58,7 @@ def plot_history(
         if result.reentry_date is not None:
             what += f", re-entry {result.reentry_date}"
     else:
-        what = f"still in orbit after {result.days / 365.25:.0f} years"
+        what = f"still in orbit after {result.days / DAYS_PER_YEAR:.0f} years"
     heights = f"{result.perigee_km - height_offset_km:.6g} x {result.apogee_km - height_offset_km:.6g} km"
     ax.set_title(f"{heights}: {what} ({result.method})", fontsize=10)
     if band_days is not None:

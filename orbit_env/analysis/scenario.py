@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.analysis.air import Air, PaperAir
 from orbit_env.checks import check_number
-from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, propagate
 from orbit_env.decay.curves import UniversalCurves, days_from_weighted_s
@@ -193,7 +193,7 @@ class Scenario:
             days = days_from_weighted_s(point.weighted_s, c, s)
             return days, np.ones(days.shape, dtype=bool)
         model = self.solar_model(
-            inclination_deg, None if max_days is None else max(max_days / 365.25, self.chunk_days / 365.25)
+            inclination_deg, None if max_days is None else max(max_days, self.chunk_days) / DAYS_PER_YEAR
         )
         own = None if own_inclination_deg is None else np.broadcast_to(own_inclination_deg, hp.shape).ravel()
         result = propagate(hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel(), inclination_deg=own)

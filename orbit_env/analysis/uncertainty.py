@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_int, check_number
+from orbit_env.constants import DAYS_PER_YEAR
 
 FloatArray = NDArray[np.float64]
 
@@ -134,7 +135,7 @@ class LifetimeSpread:
     def compliance_probability(self, rule_years: float) -> float:
         """Fraction of the samples that re-enter within ``rule_years``."""
         years = check_number(rule_years, "rule_years", unit="years", low=0.0, low_inclusive=False)
-        return float(np.mean(self.reentered & (self.days <= years * 365.25)))
+        return float(np.mean(self.reentered & (self.days <= years * DAYS_PER_YEAR)))
 
 
 def sample_factors(
@@ -225,7 +226,7 @@ def lifetime_spread(
     cols = np.arange(z_sun.size)
     days = np.exp(log_days[left, cols] * (1.0 - w) + log_days[right, cols] * w)
     reentered = up[left, cols] & up[right, cols]
-    cap = base.max_years * 365.25
+    cap = base.max_years * DAYS_PER_YEAR
     days = np.where(reentered, np.minimum(days, cap), cap)
     return LifetimeSpread(days, reentered, seed, sources)
 

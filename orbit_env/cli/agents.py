@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from orbit_env.cli.common import PROG, check_figure, positive_int
+from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
@@ -102,8 +103,8 @@ def _solar_options(args: argparse.Namespace, solar: bool) -> None:
         )
     if solar and args.dp_lookahead is not None:
         raise ValueError("--dp-lookahead applies to the known-density envs; the solar DP's policy looks a month ahead")
-    args.solar_split = "test" if args.solar_split is None else args.solar_split
-    args.disposal_years = 5.0 if args.disposal_years is None else args.disposal_years
+    args.solar_split = SOLAR_EVAL_SPLIT if args.solar_split is None else args.solar_split
+    args.disposal_years = DISPOSAL_YEARS if args.disposal_years is None else args.disposal_years
     args.dp_lookahead = 1 if args.dp_lookahead is None else args.dp_lookahead
 
 
@@ -115,7 +116,14 @@ def _yardsticks(args: argparse.Namespace, *, lookahead: bool = True) -> dict[str
 
 def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
-    from orbit_env.agents.evaluate import format_table, load_model, paired_difference, plot_returns, summarize
+    from orbit_env.agents.evaluate import (
+        format_table,
+        load_model,
+        paired_difference,
+        plot_returns,
+        policy_width,
+        summarize,
+    )
     from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
     from orbit_env.envs import SOLAR_CONTINUOUS_ENV_ID
 
@@ -166,9 +174,10 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         return 0
     title = f"{args.env} ({args.solar_split} split)"
     print(format_table(title, args.episodes, args.seed, table, list(paired.values())))
+    width = policy_width(report["policies"])
     for name, row in report["policies"].items():
         print(
-            f"  {name:<17} disposal burn on {row['disposal_share']:6.1%}, "
+            f"  {name:<{width}} disposal burn on {row['disposal_share']:6.1%}, "
             f"non-compliant {row['noncompliant_share']:6.1%}, re-entered {row['reentered_share']:6.1%}"
         )
     print(f"thresholds tuned on the train split: {report['tuned']}")
@@ -308,14 +317,16 @@ def add_parsers(sub: Any) -> None:
     )
     ev.add_argument(
         "--solar-split",
-        choices=("train", "test"),
-        help="the solar task: the record's split the missions are drawn from (default test: cycles 24-25)",
+        choices=SOLAR_SPLITS,
+        help=f"the solar task: the record's split the missions are drawn from (default {SOLAR_EVAL_SPLIT}: "
+        "cycles 24-25)",
     )
     ev.add_argument(
         "--disposal-years",
         type=float,
         metavar="Y",
-        help="the solar task: the disposal rule, re-entry within Y years of the mission's end (default 5)",
+        help=f"the solar task: the disposal rule, re-entry within Y years of the mission's end "
+        f"(default {DISPOSAL_YEARS:g})",
     )
     ev.add_argument(
         "--workers",

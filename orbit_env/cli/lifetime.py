@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
-from orbit_env.analysis.air.msis import MSIS_VERSION_CHOICES
+from orbit_env.analysis.air.msis import DEFAULT_ACTIVITY, MSIS_VERSION_CHOICES
 from orbit_env.analysis.drag_source import SOURCE_DEFAULT, SOURCE_SATELLITE, DragSource, drag_sigma
 from orbit_env.analysis.lifetime import (
     METHODS,
@@ -41,8 +41,10 @@ from orbit_env.cli.common import (
     positive_int,
     write_csv,
 )
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS
 from orbit_env.decay.solar import (
+    DEFAULT_AP,
     TableActivity,
     iso_date,
     unix_days,
@@ -135,7 +137,7 @@ def _check_inclination(args: argparse.Namespace) -> None:
 def _days_text(days: float) -> str:
     """A lifetime in days and years; under a day in three digits and hours, never "0.00 days"."""
     if days >= 1.0 or days == 0.0:
-        return f"{days:.2f} days ({days / 365.25:.2f} years)"
+        return f"{days:.2f} days ({days / DAYS_PER_YEAR:.2f} years)"
     return f"{days:.3g} days ({days * 24.0:.3g} hours)"
 
 
@@ -251,7 +253,8 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         if summary.get("reentry_date"):
             print(f"re-entry           {summary['reentry_date']}")
     else:
-        print(f"lifetime           still in orbit after {result.days / 365.25:.0f} years (where the propagation stops)")
+        years = result.days / DAYS_PER_YEAR
+        print(f"lifetime           still in orbit after {years:.0f} years (where the propagation stops)")
     if args.uncertainty:
         for line in orbit_inputs.uncertainty_lines(summary):
             print(line)
@@ -416,9 +419,18 @@ def _add_atmosphere_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument("--h0-km", type=number, metavar="KM", help="exponential: reference height (with --rho0)")
     group.add_argument("--scale-height-km", type=number, metavar="KM", help="exponential: scale height (with --rho0)")
-    group.add_argument("--f107", type=number, metavar="SFU", help="msis: daily F10.7, constant (default 150)")
+    group.add_argument(
+        "--f107",
+        type=number,
+        metavar="SFU",
+        help=f"msis: daily F10.7, constant (default {DEFAULT_ACTIVITY.f107_sfu:g})",
+    )
     group.add_argument("--f107a", type=number, metavar="SFU", help="msis: 81-day mean F10.7 (default: --f107)")
-    group.add_argument("--ap", type=number, help="msis: daily Ap (default 15; 12 for a CSV without an ap column)")
+    group.add_argument(
+        "--ap",
+        type=number,
+        help=f"msis: daily Ap (default {DEFAULT_ACTIVITY.ap:g}; {DEFAULT_AP:g} for a CSV without an ap column)",
+    )
     group.add_argument("--solar-csv", metavar="CSV", help="msis: F10.7 (f107a, ap) by date (see orbit_env.decay.solar)")
     group.add_argument("--solar-cycle", action="store_true", help="msis: the built-in smooth solar cycle")
     group.add_argument("--cycle-phase", type=number, metavar="0-1", help="msis: cycle phase at --epoch (0 = minimum)")

@@ -33,7 +33,7 @@ from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
 from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.cli.common import number
-from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
 from orbit_env.physics.orbit import MAX_APOGEE_M
 
 if TYPE_CHECKING:
@@ -482,7 +482,7 @@ def uncertainty_lines(summary: dict[str, Any]) -> list[str]:
     if len(known) == 3 and known[2] < SHORT_BAND_DAYS:  # "0.08 / 0.09 / 0.12 years" would say little
         band = " / ".join(f"{value:.1f}" for value in known) + " days"
     else:
-        parts = [" / ".join(f"{value / 365.25:.2f}" for value in known) + " years"] if known else []
+        parts = [" / ".join(f"{value / DAYS_PER_YEAR:.2f}" for value in known) + " years"] if known else []
         band = " / ".join(parts + ["beyond the propagation"] * (3 - len(known)))
     samples = f"{summary['uncertainty_samples']} samples, seed {summary['uncertainty_seed']}"
     lines = [f"lifetime 5/50/95%  {band} ({samples})"]

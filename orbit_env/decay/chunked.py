@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import check_number
 from orbit_env.constants import (
+    DAYS_PER_YEAR,
     G0_M_S2,
     REENTRY_ALTITUDE_M,
     SECONDS_PER_DAY,
@@ -764,7 +765,7 @@ def _propagate(
     n = hp.size
     gcs = G0_M_S2 * c * scale
     spread = _Spread.of(model, inclination_deg, hp, ha)
-    days = np.full(n, model.max_years * 365.25)
+    days = np.full(n, model.max_years * DAYS_PER_YEAR)
     reentered = hp <= REENTRY_ALTITUDE_M
     days[reentered] = 0.0
     active = np.flatnonzero(~reentered)
@@ -774,7 +775,7 @@ def _propagate(
     history_t, history_hp, history_ha = [0.0], [hp.copy()], [ha.copy()]
     bins: set[tuple[float, float]] = set()
     dt_s = model.chunk_days * SECONDS_PER_DAY
-    n_chunks = math.ceil(model.max_years * 365.25 / model.chunk_days)
+    n_chunks = math.ceil(model.max_years * DAYS_PER_YEAR / model.chunk_days)
     for k in range(n_chunks):
         if active.size == 0:
             break

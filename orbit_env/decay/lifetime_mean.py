@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel, Trajectory, integrate_averaged
 from orbit_env.decay.chunked import SolarDecayModel
 from orbit_env.decay.curves import days_from_weighted_s
@@ -42,7 +42,7 @@ FloatArray = NDArray[np.float64]
 #: Spacing of the profiles averaged [days]: one solar rotation.
 SAMPLE_DAYS = 27.0
 #: The first pass's window [days]: one solar cycle.
-FIRST_WINDOW_DAYS = 11.0 * 365.25
+FIRST_WINDOW_DAYS = 11.0 * DAYS_PER_YEAR
 #: Passes: the window of each is the lifetime the one before gave.
 PASSES = 2
 #: A first pass's life this many times the cap ends the search: still up. The second pass's air moved lives
@@ -131,7 +131,7 @@ def mean_air_lifetime(
     ``drag_parameter_m2_kg``: c_x A / m times any density scale. A life longer
     than the model's ``max_years`` is reported as not re-entered, at ``max_years``.
     """
-    cap_days = model.max_years * 365.25
+    cap_days = model.max_years * DAYS_PER_YEAR
     window = min(FIRST_WINDOW_DAYS, cap_days)
     for _ in range(PASSES):
         atmosphere = mean_profile(model, window)

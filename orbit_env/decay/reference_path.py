@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from orbit_env.constants import G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
+from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.solar import day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
@@ -56,7 +56,7 @@ def integrate_reference(
     """
     solution = _solve_reference(perigee_m, apogee_m, drag_parameter_m2_kg, model, profile_step_days, rtol)
     if solution.status != 1:
-        return model.max_years * 365.25
+        return model.max_years * DAYS_PER_YEAR
     return float(solution.t_events[0][0]) / SECONDS_PER_DAY
 
 
@@ -122,7 +122,7 @@ def _solve_reference(
 
     reentry.terminal = True  # type: ignore[attr-defined]
     p0, e0 = (float(x) for x in elements_from_heights(perigee_m, apogee_m))
-    t_max = model.max_years * 365.25 * SECONDS_PER_DAY
+    t_max = model.max_years * DAYS_PER_YEAR * SECONDS_PER_DAY
     from scipy.integrate import solve_ivp  # on use: half a second of start-up
 
     solution = solve_ivp(

@@ -36,6 +36,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.checks import InputError, check_array, check_number, format_number
+from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.physics.atmosphere.msis import AP_RANGE, F107_RANGE_SFU
 
@@ -48,7 +49,7 @@ DEFAULT_AP = 12.0
 #: Dates a solar table may hold: daily F10.7 is measured since 1947; no use here reaches past 2200.
 SOLAR_TABLE_DATES = ("1947-01-01", "2200-12-31")
 #: Mean length of the solar cycle [days] (11.0 years).
-SOLAR_CYCLE_DAYS = 11.0 * 365.25
+SOLAR_CYCLE_DAYS = 11.0 * DAYS_PER_YEAR
 
 
 def unix_days(date: str | _dt.date | np.datetime64) -> float:
@@ -280,7 +281,7 @@ class CycleActivity:
 
     def __post_init__(self) -> None:
         check_number(self.minimum_days, "minimum_days", unit="unix days")
-        check_number(self.period_days, "period_days", unit="days", low=365.0, high=40 * 365.25)
+        check_number(self.period_days, "period_days", unit="days", low=365.0, high=40 * DAYS_PER_YEAR)
         check_number(self.peak_phase, "peak_phase", low=0.1, high=0.9)
         low, high = F107_RANGE_SFU
         check_number(self.f107_min_sfu, "f107_min_sfu", unit="sfu", low=low, high=high)

@@ -33,10 +33,13 @@ if TYPE_CHECKING:
     from orbit_env.envs.solar import OrbitRaisingSolarEnv
 
 __all__ = [
+    "DISPOSAL_YEARS",
     "ENV_IDS",
     "SOLAR_CONTINUOUS_ENV_ID",
     "SOLAR_ENV_ID",
     "SOLAR_ENV_IDS",
+    "SOLAR_EVAL_SPLIT",
+    "SOLAR_SPLITS",
     "DensityConfig",
     "OrbitRaisingConfig",
     "OrbitRaisingEnv",
@@ -65,6 +68,13 @@ SOLAR_CONTINUOUS_ENV_ID = "OrbitRaisingSolarContinuous-v0"
 #: The ids of the solar task, and the keywords that make each.
 _SOLAR_VARIANTS: dict[str, dict[str, object]] = {SOLAR_ENV_ID: {}, SOLAR_CONTINUOUS_ENV_ID: {"continuous": True}}
 SOLAR_ENV_IDS = tuple(_SOLAR_VARIANTS)
+#: The solar task's splits of the record (`orbit_env.envs.solar_task.SPLIT_DATE`): training's and the held-out one.
+SOLAR_SPLITS = ("train", "test")
+#: The split the solar task's yardsticks score on unless told otherwise (``orbit-env evaluate``, the sweep, the
+#: certificate): the held-out cycles.
+SOLAR_EVAL_SPLIT = "test"
+#: The solar task's disposal rule unless told otherwise [years after the mission's end]: the FCC's 2022 rule for LEO.
+DISPOSAL_YEARS = 5.0
 _SOLAR_ENTRY_POINTS = ("orbit_env.envs.solar:OrbitRaisingSolarEnv", "orbit_env.envs.solar:OrbitRaisingSolarVectorEnv")
 #: The ids of the known-density family (one task model, `orbit_env.envs.task`).
 ENV_IDS = tuple(_VARIANTS)

@@ -35,16 +35,21 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from orbit_env.checks import check_number
+from orbit_env.constants import DAYS_PER_YEAR, SECONDS_PER_DAY
 from orbit_env.decay.curves import NU_REF, UniversalCurves, nu_per_revolution
 from orbit_env.decay.drag_clock import DragClock, drag_clock
 from orbit_env.decay.solar import iso_date, unix_days
-from orbit_env.envs import solar_kernel
+from orbit_env.envs import DISPOSAL_YEARS, SOLAR_SPLITS, solar_kernel
+from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig
 from orbit_env.envs.state import STALE_SEGMENT, BatchState
 from orbit_env.envs.task import (
+    LIFETIME_SCALE_DAYS,
+    OBS_HIGH,
     OBS_NAMES,
     Task,
     kernel_parameters,
+    observation_batch,
     place,
     update_satellite,
 )
@@ -55,8 +60,6 @@ FloatArray = NDArray[np.float64]
 #: The day that splits the record: training missions end before it (solar cycles 19-23), test missions
 #: begin on or after it (cycles 24-25, held out).
 SPLIT_DATE = "2009-01-01"
-#: The splits of the record a mission's start is drawn from.
-SOLAR_SPLITS = ("train", "test")
 #: Days of the record a mission's first day needs before it: the observation's trailing 365-day mean.
 HISTORY_DAYS = 365
 #: Candidate perigees of the disposal burn per pass (from 100 km to the perigee, searched by bisection; two
@@ -95,7 +98,7 @@ SOLAR_OBS_INDEX = {name: i for i, name in enumerate(SOLAR_OBS_NAMES)}
 #: The solar indices are observed in units of 100 (F10.7 in sfu, Ap).
 SOLAR_INDEX_SCALE = 100.0
 SOLAR_OBS_LOW = np.zeros(len(SOLAR_OBS_NAMES), dtype=np.float32)
-SOLAR_OBS_HIGH = np.array([1.2, 5.0, 3.0, 1.0, 1.0, 1.0, 1.0, 5.0, 5.0, 5.0, 5.0], dtype=np.float32)
+SOLAR_OBS_HIGH = np.concatenate([OBS_HIGH, np.full(4, 5.0, dtype=np.float32)])
 _BOUNDS = np.array([SOLAR_OBS_LOW, SOLAR_OBS_HIGH], dtype=np.float64)  # as the compiled observation reads them
 
 
@@ -106,15 +109,15 @@ class SolarMission:
     Args:
         solar_split: ``"train"`` (missions wholly before `SPLIT_DATE`: cycles 19-23) or ``"test"``
             (missions wholly from it, within the observed record: cycles 24-25).
-        disposal_years: The rule: re-enter within this many years of the mission's end (5: the FCC's
-            rule of 2022 for low orbits; 25: the IADC guideline).
+        disposal_years: The rule: re-enter within this many years of the mission's end (`DISPOSAL_YEARS`,
+            5: the FCC's rule of 2022 for low orbits; 25: the IADC guideline).
         block_days: Days of a step (30: a month, an operator's planning cycle).
         inclination_deg: The orbit's inclination (53 deg: the most populated shell of today).
         start_span_km: A start's apogee lies up to this far above its perigee (uniform).
     """
 
     solar_split: str = "train"
-    disposal_years: float = 5.0
+    disposal_years: float = DISPOSAL_YEARS
     block_days: int = 30
     inclination_deg: float = 53.0
     start_span_km: float = 20.0
@@ -131,7 +134,7 @@ class SolarMission:
     @property
     def disposal_days(self) -> float:
         """The rule's time from the mission's end to re-entry, at most [days] (365.25-day years)."""
-        return self.disposal_years * 365.25
+        return self.disposal_years * DAYS_PER_YEAR
 
 
 @dataclass(frozen=True)
@@ -346,6 +349,32 @@ def today(task: SolarTask, state: BatchState) -> FloatArray:
 def drag_rate(state: BatchState) -> FloatArray:
     """The rate g c of each satellite: W falls by g c times the drag clock [s] (Eq. 4.1)."""
     return nu_per_revolution(state.drag_area_m2 / state.mass_kg, 1.0)
+
+
+def predicted_life_days(component: Any) -> FloatArray:
+    """The predicted lifetime [days] an observation's ``predicted_lifetime`` component L / (L + 365) shows.
+
+    The component is clipped into [1e-9, 1 - 1e-9]: a life of a few hundredths of a second at least, finite.
+    """
+    x = np.clip(np.asarray(component, dtype=np.float64), 1e-9, 1.0 - 1e-9)
+    return LIFETIME_SCALE_DAYS * x / (1.0 - x)
+
+
+def decode(task: SolarTask, observation: Any) -> BatchState:
+    """The states a ground station recovers from observations (11,) or (n, 11), for a planner.
+
+    The orbit, tank and steps as the known-density task recovers them (`orbit_env.envs.task.decode`),
+    and the last month's multiplier (``density_scale``) from the predicted lifetime, which the
+    observation computes from it (`observe`).
+
+    Raises:
+        ValueError: an observation of another shape, or not finite.
+    """
+    obs = observation_batch(observation, len(SOLAR_OBS_NAMES))
+    state = task_model.decode(task, obs[:, : len(OBS_NAMES)])
+    life_days = predicted_life_days(obs[:, SOLAR_OBS_INDEX["predicted_lifetime"]])
+    state.density_scale = state.period_s * state.nu / (drag_rate(state) * life_days * SECONDS_PER_DAY)
+    return state
 
 
 def coast_block(

@@ -686,15 +686,15 @@ def observe(task: Task, state: AnyState) -> NDArray[np.float32]:
     return np.array(columns, dtype=np.float32).T
 
 
-def observation_batch(observation: Any) -> FloatArray:
-    """One observation (7,) or a batch (n, 7) as a finite float64 batch (n, 7).
+def observation_batch(observation: Any, width: int = len(OBS_NAMES)) -> FloatArray:
+    """One observation (width,) or a batch (n, width) as a finite float64 batch (n, width): 7, or the solar task's 11.
 
     Raises:
         ValueError: another shape, or a value that is not finite.
     """
     obs = np.asarray(observation, dtype=np.float64)
-    if obs.ndim not in (1, 2) or obs.shape[-1:] != (len(OBS_NAMES),) or not np.all(np.isfinite(obs)):
-        raise ValueError(f"observation must be finite with shape (7,) or (n, 7), got shape {obs.shape}")
+    if obs.ndim not in (1, 2) or obs.shape[-1:] != (width,) or not np.all(np.isfinite(obs)):
+        raise ValueError(f"observation must be finite with shape ({width},) or (n, {width}), got shape {obs.shape}")
     return np.atleast_2d(obs)
 
 

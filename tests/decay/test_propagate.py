@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from orbit_env.analysis.air import MsisAir
-from orbit_env.analysis.disposal import apogee_speed_m_s, check_disposal_rule, perigee_lowering_dv_m_s
+from orbit_env.analysis.disposal import check_disposal_rule
 from orbit_env.analysis.lifetime import Satellite, check_rule, lifetime
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.decay.solar import ConstantActivity, CycleActivity, TableActivity, unix_days
+from orbit_env.physics.orbit import apogee_velocity_m_s, dv_to_lower_perigee_m_s
 
 SATELLITE = Satellite(2.2, 100.0, 1.0)
 START = unix_days("2021-06-01")
@@ -147,8 +148,8 @@ def test_perigee_lowering_burn_formula():
     mu, r = 3.986e14, 6371e3 + 700e3
     rp = 6371e3 + 300e3
     expected = math.sqrt(mu / r) - math.sqrt(2 * mu * rp / (r * (r + rp)))
-    assert perigee_lowering_dv_m_s(700e3, 700e3, 300e3) == pytest.approx(expected, rel=1e-12)
-    assert apogee_speed_m_s(700e3, 700e3) == pytest.approx(math.sqrt(mu / r), rel=1e-12)
+    assert dv_to_lower_perigee_m_s(700e3, 700e3, 300e3) == pytest.approx(expected, rel=1e-12)
+    assert apogee_velocity_m_s(700e3, 700e3) == pytest.approx(math.sqrt(mu / r), rel=1e-12)
 
 
 def test_rule_search_finds_the_boundary():
@@ -163,7 +164,7 @@ def test_rule_search_finds_the_boundary():
     assert check.dv_m_s[0] == 0.0
     # The reported perigee complies and is within the search resolution (700 km / 17^3) of 500 km.
     assert 500e3 - 700e3 / 17**3 * 1.01 <= check.new_perigee_m[1] <= 500e3
-    assert check.dv_m_s[1] == pytest.approx(perigee_lowering_dv_m_s(800e3, 900e3, 500e3), rel=5e-3)
+    assert check.dv_m_s[1] == pytest.approx(dv_to_lower_perigee_m_s(800e3, 900e3, 500e3), rel=5e-3)
     with pytest.raises(ValueError, match=r"^rule_years=0 is out of range; allowed: above 0 years$"):
         check_disposal_rule(500e3, 500e3, 0.0, law)
 

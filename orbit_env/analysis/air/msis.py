@@ -121,8 +121,9 @@ class MsisAir(Air):
 
             activity = load_record()
         else:
-            f107 = 150.0 if f107 is None else f107
-            activity = ConstantActivity(f107, f107 if f107a is None else f107a, 15.0 if ap is None else ap)
+            f107 = DEFAULT_ACTIVITY.f107_sfu if f107 is None else f107
+            ap = DEFAULT_ACTIVITY.ap if ap is None else ap
+            activity = ConstantActivity(f107, f107 if f107a is None else f107a, ap)
         text_version = options.get("msis_version")
         if text_version is not None and text_version not in MSIS_VERSION_CHOICES:
             raise ValueError(f"--msis-version must be one of {', '.join(MSIS_VERSION_CHOICES)}, got {text_version!r}")
