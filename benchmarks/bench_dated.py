@@ -81,7 +81,7 @@ def main() -> None:
         command += ["--inclination", inc, "--epoch", epoch, *SATELLITE]
         cold, out = run(command, folder)
         life = next(line for line in out.splitlines() if line.startswith("lifetime "))
-        for table in Path(folder).glob("airdays-*"):
+        for table in Path(folder).glob("v-*/airdays-*"):
             table.unlink()
         air_cold, _ = run(command, folder)
         warm = statistics.median(run(command, folder)[0] for _ in range(args.repeats))

@@ -2,12 +2,17 @@
 
 Each entry is one ``.npz`` file (compressed unless its arrays are already) of named arrays, or a folder of ``.npy``
 files that are mapped rather than read (the universal curves: ``store(..., mapped=True)``), in the user's cache folder
-(``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux),
-under a name made from a hash of everything that shapes the table: its kind, a
-description of its inputs (the ``repr`` of frozen dataclasses of plain numbers),
-the package's source code (every module: the physics under a table changes
-with any of them), its version and `FORMAT_VERSION`. A change of any of them is a new name, so a stale table is
-never read (old files stay until the cache folder is cleared).
+(``platformdirs.user_cache_dir("orbit-env")``, e.g. ``~/.cache/orbit-env`` on Linux). Each
+version of the package has a folder there of its own, its *generation* (``v-`` and a hash of
+the package's source code, every module: the physics under a table changes with any of them,
+its version and `FORMAT_VERSION`), so a stale table is never read; in it a table's name is a hash
+of its kind and a description of its inputs (the ``repr`` of frozen dataclasses of plain numbers).
+
+Old generations do not pile up: the first write of a process deletes the generations other
+than its own and the `KEEP_GENERATIONS` - 1 used last (a generation is used when a process
+reads or writes it: two installed versions taking turns keep their tables), and the tables of
+the layout before generations (``<kind>-<hash>`` at the folder's top). Nothing else in the
+folder is touched (`prune`).
 
 Writes are atomic: a table is written to a temporary file in the same folder and
 renamed over its name, so processes that race build the same table twice at most
@@ -28,6 +33,7 @@ import dataclasses
 import functools
 import hashlib
 import os
+import re
 import shutil
 import tempfile
 import zipfile
@@ -48,11 +54,20 @@ except ImportError:  # not POSIX: `locked` does not lock
 ENV_VAR = "ORBIT_ENV_CACHE_DIR"
 #: Bumped when the layout of a cached table changes.
 FORMAT_VERSION = 1
+#: Generations kept in the cache folder by `prune`: this process's and those used last.
+KEEP_GENERATIONS = 3
+#: A generation's folder, and a table of the layout before generations (a file, its lock or a folder of arrays).
+_GENERATION_NAME = re.compile(r"v-[0-9a-f]{16}")
+_FLAT_TABLE_NAME = re.compile(r"[a-z]+-[0-9a-f]{24}(\.npz|\.lock)?")
+#: A generation's marker file, touched when a process first reads or writes it: its time is the generation's last use.
+_USED = ".used"
 
 #: Values of an ``ORBIT_ENV_*`` setting (this one, `orbit_env.workers.FORK_ENV_VAR`) that turn it off.
 OFF_SETTINGS = ("off", "0", "false", "no")
 
 _disabled = False
+_marked: set[Path] = set()  # generation folders this process has marked used
+_pruned: set[Path] = set()  # cache folders this process has pruned
 
 
 def disable() -> None:
@@ -114,14 +129,84 @@ def source_digest() -> str:
     return digest.hexdigest()
 
 
-def _path(kind: str, description: str) -> Path | None:
-    folder = cache_dir()
-    if folder is None:
-        return None
+@functools.cache
+def _generation() -> str:
     from orbit_env import __version__
 
-    key = f"{kind}|{FORMAT_VERSION}|{__version__}|{source_digest()}|{description}"
-    return folder / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
+    return hashlib.sha256(f"{FORMAT_VERSION}|{__version__}|{source_digest()}".encode()).hexdigest()[:16]
+
+
+def generation_dir() -> Path | None:
+    """This version's folder in the cache folder (its tables), or None when the cache is disabled."""
+    folder = cache_dir()
+    return None if folder is None else folder / f"v-{_generation()}"
+
+
+def prune(folder: Path, keep: int = KEEP_GENERATIONS) -> list[Path]:
+    """Delete from a cache folder the generations but this version's and the ``keep`` - 1 used last, and flat tables.
+
+    Flat tables are the layout's before generations (``<kind>-<24 hex digits>`` at the top).
+    Anything else in ``folder`` stays; what cannot be deleted (in use elsewhere, no permission)
+    stays too. Returns the entries deleted.
+    """
+    own = f"v-{_generation()}"
+    older: list[tuple[float, Path]] = []
+    removed: list[Path] = []
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        if _GENERATION_NAME.fullmatch(entry.name) and entry.name != own and entry.is_dir():
+            older.append((_last_used(entry), entry))
+        elif _FLAT_TABLE_NAME.fullmatch(entry.name):
+            removed.append(entry)
+    older.sort(reverse=True)
+    removed += [entry for _, entry in older[max(keep - 1, 0) :]]
+    for entry in removed:
+        if entry.is_dir():
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            entry.unlink(missing_ok=True)
+    return removed
+
+
+def _last_used(generation: Path) -> float:
+    """When a generation folder was last read or written (its marker's time; the folder's without one)."""
+    for path in (generation / _USED, generation):
+        try:
+            return path.stat().st_mtime
+        except OSError:
+            continue
+    return 0.0
+
+
+def _mark_used(generation: Path) -> None:
+    """Touch a generation's marker, once per process (`prune` keeps the generations used last)."""
+    if generation in _marked or not generation.is_dir():
+        return
+    _marked.add(generation)
+    with contextlib.suppress(OSError):
+        (generation / _USED).touch()
+
+
+def _path(kind: str, description: str) -> Path | None:
+    generation = generation_dir()
+    if generation is None:
+        return None
+    _mark_used(generation)
+    key = f"{kind}|{description}"
+    return generation / f"{kind}-{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
+
+
+def _make_folder(path: Path) -> None:
+    """The table's generation folder, made if need be and marked used; the cache folder pruned once a process."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _mark_used(path.parent)
+    folder = path.parent.parent
+    if folder not in _pruned:
+        _pruned.add(folder)
+        prune(folder)
 
 
 def load(kind: str, description: str | None, *, mapped: bool = False) -> dict[str, np.ndarray] | None:
@@ -163,7 +248,7 @@ def store(
     if path is None:
         return
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        _make_folder(path)
         if mapped:
             _store_folder(path.with_suffix(""), arrays)
             return
@@ -207,7 +292,7 @@ def locked(kind: str, description: str | None) -> Iterator[None]:
     with contextlib.ExitStack() as stack:
         if path is not None and fcntl is not None:
             try:
-                path.parent.mkdir(parents=True, exist_ok=True)
+                _make_folder(path)
                 handle = stack.enter_context(path.with_suffix(".lock").open("a"))
                 fcntl.flock(handle, fcntl.LOCK_EX)  # released when the file is closed
             except OSError:

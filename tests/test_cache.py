@@ -31,8 +31,9 @@ def test_curves_are_stored_once_and_read_back_identical(folder):
     model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 60e3))
     built = UniversalCurves(model)
     # The curves are a folder of .npy files (mapped, not read, on loading).
-    (stored,) = folder.glob("curves-*")
-    assert sorted(f.name for f in stored.iterdir()) == ["a.npy", "b.npy", "q.npy"] and not list(folder.glob("*.tmp"))
+    (stored,) = folder.glob("v-*/curves-*")
+    assert sorted(f.name for f in stored.iterdir()) == ["a.npy", "b.npy", "q.npy"]
+    assert not list(folder.glob("v-*/*.tmp"))
     loaded = UniversalCurves(model)
     assert not loaded.table_a.corners.flags.writeable  # mapped from the file
     np.testing.assert_array_equal(loaded.table_a.cells, built.table_a.cells)
@@ -41,23 +42,23 @@ def test_curves_are_stored_once_and_read_back_identical(folder):
     np.testing.assert_array_equal(loaded.locate(hp, ha).weighted_s, built.locate(hp, ha).weighted_s)
     # Another model is another folder.
     UniversalCurves(DecayModel(ExponentialAtmosphere(2e-11, 400e3, 60e3)))
-    assert len(list(folder.glob("curves-*"))) == 2
+    assert len(list(folder.glob("v-*/curves-*"))) == 2
 
 
 def test_a_damaged_file_is_built_again(folder):
     model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 50e3))
     built = UniversalCurves(model)
-    (stored,) = folder.glob("curves-*")
+    (stored,) = folder.glob("v-*/curves-*")
     (stored / "b.npy").write_bytes(b"not an array")
     assert cache.load("curves", cache.describe(model), mapped=True) is None  # unreadable: as if not cached
     again = UniversalCurves(model)
     np.testing.assert_array_equal(again.table_b.cells, built.table_b.cells)
     # Rewritten whole.
     np.testing.assert_array_equal(np.load(stored / "b.npy"), built.table_b.corners)
-    assert not list(folder.glob("*.tmp"))
+    assert not list(folder.glob("v-*/*.tmp"))
     # A table in one file likewise.
     cache.store("dp", "a test table", {"values": np.arange(3.0)})
-    (path,) = folder.glob("dp-*.npz")
+    (path,) = folder.glob("v-*/dp-*.npz")
     path.write_bytes(b"not a zip file")
     assert cache.load("dp", "a test table") is None
 
@@ -86,7 +87,7 @@ def test_no_cache_flag_writes_nothing(folder, monkeypatch, capsys):
     monkeypatch.setattr(cache, "_disabled", False)
     args[args.index("2e-11")] = "3e-11"  # another atmosphere: not in this process's memory either
     assert main(args) == 0
-    assert len(list(folder.glob("curves-*"))) == 1
+    assert len(list(folder.glob("v-*/curves-*"))) == 1
     capsys.readouterr()
 
 
@@ -94,3 +95,35 @@ def test_the_default_curves_are_one_table_in_a_process():
     from orbit_env.decay.curves import universal_curves
 
     assert universal_curves() is universal_curves(DecayModel()) is universal_curves(DecayModel(PaperAtmosphere()))
+
+
+def test_old_generations_and_flat_tables_are_pruned_and_nothing_else(folder):
+    """The first write of a process keeps its generation and the two others used last; a user's files stay."""
+    import time
+
+    stale = []
+    for age in range(4):  # four other versions' folders, the oldest used 4 hours ago
+        generation = folder / f"v-{age:016x}"
+        generation.mkdir()
+        (generation / "curves-0123.npz").write_bytes(b"x")
+        (generation / ".used").touch()
+        used = time.time() - 3600.0 * (age + 1)
+        os.utime(generation / ".used", (used, used))
+        stale.append(generation)
+    flat = [folder / f"dp-{'a' * 24}.npz", folder / f"curves-{'b' * 24}", folder / f"msis-{'c' * 24}.lock"]
+    flat[0].write_bytes(b"x")
+    flat[1].mkdir()
+    flat[2].write_bytes(b"")
+    mine = [folder / "notes.txt", folder / "v-not-a-generation", folder / "dp-123.npz"]
+    mine[0].write_text("a user's file")
+    mine[1].mkdir()
+    mine[2].write_bytes(b"x")
+    cache.store("dp", "a pruning test", {"values": np.arange(3.0)})  # the first write into this (new) folder
+    kept = sorted(p.name for p in folder.iterdir())
+    own = cache.generation_dir().name
+    assert kept == sorted([own, stale[0].name, stale[1].name, *(p.name for p in mine)])
+    assert cache.load("dp", "a pruning test")["values"].tolist() == [0.0, 1.0, 2.0]
+    # Once a process: a later write does not prune again.
+    (folder / stale[3].name).mkdir()
+    cache.store("dp", "another table", {"values": np.arange(2.0)})
+    assert (folder / stale[3].name).is_dir()

@@ -196,7 +196,7 @@ def test_solutions_are_cached_and_coarse_grids_solve():
 def test_a_solution_read_from_the_disk_cache_is_the_one_solved(monkeypatch, tmp_path):
     monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
     solved = dp._solve.__wrapped__(CONFIG, GRID, 1.0, False)
-    assert list(tmp_path.glob("dp-*.npz")), "the solution is written to the cache"
+    assert list(tmp_path.glob("v-*/dp-*.npz")), "the solution is written to the cache"
 
     def refuse(*args):
         raise AssertionError("solved again although cached")

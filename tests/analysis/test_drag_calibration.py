@@ -137,7 +137,7 @@ def test_a_history_fits_air_is_kept_on_disk_under_a_key_of_all_it_reads(monkeypa
     scenario = Scenario(MsisAir(load_record(), sets[-1].epoch_days), rotating_atmosphere=True)
     first = fit_history(sets, scenario)
     steps = len(calls)
-    assert steps == 45 and len(list(tmp_path.glob("fit-*.npz"))) == 1  # 45 daily steps over 44.2 days
+    assert steps == 45 and len(list(tmp_path.glob("v-*/fit-*.npz"))) == 1  # 45 daily steps over 44.2 days
     assert fit_history(sets, scenario) == first and len(calls) == steps  # read back, no NRLMSIS
     scaled = fit_history(sets, Scenario(scenario.air, density_scale=2.0, rotating_atmosphere=True))
     assert len(calls) == 2 * steps
@@ -145,7 +145,7 @@ def test_a_history_fits_air_is_kept_on_disk_under_a_key_of_all_it_reads(monkeypa
     quiet = MsisAir(ConstantActivity(70.0, 70.0, 4.0), sets[-1].epoch_days)
     assert fit_history(sets, Scenario(quiet, rotating_atmosphere=True)) != first and len(calls) == 3 * steps
     fit_history(sets[1:], scenario)
-    assert len(calls) > 3 * steps and len(list(tmp_path.glob("fit-*.npz"))) == 4
+    assert len(calls) > 3 * steps and len(list(tmp_path.glob("v-*/fit-*.npz"))) == 4
 
 
 def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():

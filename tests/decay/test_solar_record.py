@@ -128,7 +128,7 @@ def test_a_record_read_back_from_the_disk_cache_is_the_parsed_one(tmp_path, monk
     parsed = read_record(SHIPPED_RECORD)
     solar_record._load.cache_clear()
     first = solar_record._load(str(SHIPPED_RECORD))  # parses and stores
-    assert len(list(tmp_path.glob("record-*"))) == 1
+    assert len(list(tmp_path.glob("v-*/record-*"))) == 1
     solar_record._load.cache_clear()
     monkeypatch.setattr(solar_record, "read_record", pytest.fail)  # the file is not parsed again
     cached = solar_record._load(str(SHIPPED_RECORD))

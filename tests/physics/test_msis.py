@@ -243,7 +243,7 @@ def test_every_table_cache_is_keyed_by_the_version(tmp_path, monkeypatch):
     _cached_log_density_table.cache_clear()
     v21 = MsisAtmosphere(*conditions).log_density_table()
     v00 = MsisAtmosphere(*conditions, version=0.0).log_density_table()  # in memory: a 2.1 table is there
-    assert len(list(tmp_path.glob("msis-*.npz"))) == 2  # one file per version
+    assert len(list(tmp_path.glob("v-*/msis-*.npz"))) == 2  # one file per version
     assert np.all(np.exp(v00 - v21)[(ALTITUDE_GRID_M >= 300e3) & (ALTITUDE_GRID_M <= 500e3)] > 1.05)
     # From the disk, each version reads its own table back.
     _cached_log_density_table.cache_clear()
