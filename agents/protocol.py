@@ -1,4 +1,4 @@
-"""Stable-Baselines3's prediction protocol, written once: every hand-coded policy, the DPs and the planner answer it.
+"""Stable-Baselines3's prediction protocol, written once: the hand-coded policies, the DP's policy and the planner.
 
 ``predict(observation, state=None, episode_start=None, deterministic=True) -> (action, state)``, for
 one observation or a batch, as SB3's models take them: `orbit_env.agents.evaluate` scores a policy
@@ -19,7 +19,7 @@ class Predicts:
     """
 
     def actions_of(self, observation: Any) -> Any:
-        """The actions of observations, a batch (n,) of them for one observation or n (subclasses)."""
+        """The actions of one observation or a batch of n (subclasses): (n,) indices, or (n, 1) Box values."""
         raise NotImplementedError
 
     def predict(

@@ -4,8 +4,8 @@ Hand-coded operators' rules act on the observation alone, as an operator would
 (`SOLAR_RULES`, in the order of the rows): never burn; burn the whole tank at once; reboost
 when the perigee falls below a threshold; reboost when the predicted lifetime falls below a
 share of the mission's time left; the greedy look-ahead on the observed activity held constant.
-A rule with a ``grid`` has its threshold (and the reserve it keeps) tuned on the train split
-(`tune`), never on the test split. Each answers SB3's ``predict`` as well as ``actions``. A new
+A `Threshold` rule has its threshold (from its ``grid``) and the reserve it keeps tuned on the
+train split (`tune`), never on the test split. Each answers SB3's ``predict`` as well as ``actions``. A new
 rule is a class here and its entry in `SOLAR_RULES`. The optimum is the per-episode DP
 (`orbit_env.agents.solar_dp`), which knows the Sun's future.
 
@@ -67,11 +67,10 @@ class Never(Predicts):
 
     The base of the operators' rules: a rule's ``actions`` maps observations (n, 11) to burn
     sizes' indices; ``predict`` answers SB3's protocol with them, in either solar id's action
-    space. ``name`` is the rule's row; ``grid``, where not None, the thresholds `tune` tries.
+    space. ``name`` is the rule's row.
     """
 
     name = "never"
-    grid: tuple[float, ...] | None = None
 
     def __init__(self, task: SolarTask) -> None:
         self.task = task
@@ -104,7 +103,12 @@ class AllAtOnce(Never):
 
 
 class Threshold(Never):
-    """A reboost rule: the largest burn when a measure falls below ``threshold``, keeping ``reserve_m_s`` [m/s]."""
+    """A reboost rule: the largest burn when a measure falls below ``threshold``, keeping ``reserve_m_s`` [m/s].
+
+    ``grid``: the thresholds `tune` tries (each with every reserve of `RESERVES_M_S`).
+    """
+
+    grid: tuple[float, ...] = ()
 
     def __init__(self, task: SolarTask, threshold: float, reserve_m_s: float) -> None:
         super().__init__(task)
@@ -310,24 +314,23 @@ def fly_model(
 
 
 def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
-    """The thresholds (and reserves) of the two threshold rules that do best on the train split.
+    """The threshold and reserve of each `Threshold` rule of `SOLAR_RULES` that do best on the train split.
 
     Each candidate flies the same `TUNE_EPISODES` missions of the train split (seed `TUNE_SEED`),
     whatever split ``task`` is on; the rules burn their sizes, so the continuous twin's are the same.
     """
-    return _tune(task.config, _with_split(task.mission, "train"))
+    rules = tuple(rule for rule in SOLAR_RULES if issubclass(rule, Threshold))
+    return _tune(task.config, _with_split(task.mission, "train"), rules)
 
 
 @lru_cache(maxsize=4)
-def _tune(config: Any, mission: SolarMission) -> dict[str, tuple[float, float]]:
+def _tune(config: Any, mission: SolarMission, rules: tuple[type[Threshold], ...]) -> dict[str, tuple[float, float]]:
     train = SolarTask(config=config, mission=mission)
     options = starts(train, TUNE_EPISODES, TUNE_SEED)
     best: dict[str, tuple[float, float]] = {}
-    for rule in SOLAR_RULES:
-        if rule.grid is None:
-            continue
+    for rule in rules:
         scores = {
-            (float(x), reserve): fly(train, options, by_observation(train, rule(train, x, reserve))).returns.mean()  # type: ignore[call-arg]
+            (float(x), reserve): fly(train, options, by_observation(train, rule(train, x, reserve))).returns.mean()
             for x in rule.grid
             for reserve in RESERVES_M_S
         }
@@ -342,12 +345,18 @@ def _with_split(mission: SolarMission, split: str) -> SolarMission:
 def hand_coded(task: SolarTask) -> dict[str, Never]:
     """The operators' rules by name, in `SOLAR_RULES`' order, the thresholds tuned on the train split (`tune`)."""
     tuned = tune(task)
-    return {rule.name: rule(task) if rule.grid is None else rule(task, *tuned[rule.name]) for rule in SOLAR_RULES}  # type: ignore[call-arg]
+    return {rule.name: _made(rule, task, tuned) for rule in SOLAR_RULES}
 
 
-#: The operators' rules in the order of the rows (the optimum's row follows them).
+def _made(rule: type[Never], task: SolarTask, tuned: Mapping[str, tuple[float, float]]) -> Never:
+    if issubclass(rule, Threshold):
+        return rule(task, *tuned[rule.name])
+    return rule(task)
+
+
+#: The operators' rules in the order of the rows (the optimum's row follows them): each row of `evaluate_solar`.
 SOLAR_RULES: tuple[type[Never], ...] = (Never, AllAtOnce, PerigeeThreshold, LifeThreshold, GreedyConstant)
-#: Their names.
+#: The shipped rules' names (an evaluation's own are `SolarEvaluation.rules`).
 SOLAR_HAND_CODED = tuple(rule.name for rule in SOLAR_RULES)
 
 
@@ -400,6 +409,7 @@ class SolarEvaluation:
     flown: dict[str, Flown]
     dp_estimate: FloatArray  # V_0 of the DP's grid at each start (the certificate's other side)
     tuned: dict[str, tuple[float, float]]
+    rules: tuple[str, ...]  # the hand-coded rules' rows, in order (`SOLAR_RULES`)
 
 
 def evaluate_solar(
@@ -430,9 +440,9 @@ def evaluate_solar(
     say("tuning the thresholds on the train split")
     policies = hand_coded(task)
     flown = {}
-    for name in SOLAR_HAND_CODED:
+    for name, policy in policies.items():
         say(name)
-        flown[name] = fly(task, options, by_observation(task, policies[name]))
+        flown[name] = fly(task, options, by_observation(task, policy))
     estimate = np.full(episodes, np.nan)
     if include_dp:
         say(f"dp ({episodes} missions, one DP each)")
@@ -450,7 +460,7 @@ def evaluate_solar(
     for name, model in (learned or {}).items():
         say(name)
         flown[name] = fly(task, options, by_model(task, model))
-    return SolarEvaluation(flown, estimate, dict(tune(task)))
+    return SolarEvaluation(flown, estimate, dict(tune(task)), tuple(policies))
 
 
 def solar_report(evaluation: SolarEvaluation) -> dict[str, Any]:
@@ -470,7 +480,7 @@ def solar_report(evaluation: SolarEvaluation) -> dict[str, Any]:
     if "dp" in evaluation.flown:
         dp = evaluation.flown["dp"].returns
         gap = evaluation.dp_estimate - dp
-        rules = np.max([evaluation.flown[name].returns for name in SOLAR_HAND_CODED], axis=0)
+        rules = np.max([evaluation.flown[name].returns for name in evaluation.rules], axis=0)
         report["rule_binds_share"] = report["policies"]["dp"]["disposal_share"]
         report["certificate"] = {
             "mean_gap_days": float(gap.mean()),

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from orbit_env.agents.solar import Flown, fly
 from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import unix_days
-from orbit_env.envs import solar_task
+from orbit_env.envs import SOLAR_EVAL_SPLIT, SOLAR_SPLITS, solar_task
 from orbit_env.envs.solar_task import SolarStep, SolarTask
 from orbit_env.envs.state import BatchState
 
@@ -369,7 +369,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out-maps", default="solar-burn-maps.png", help="the burn maps' figure (PNG)")
     parser.add_argument("--episodes", type=int, default=200, help="missions flown (one DP each: 1-2 s)")
     parser.add_argument("--seed", type=int, default=EVAL_SEED, help="seed of the missions (evaluate's)")
-    parser.add_argument("--split", default="test", choices=("train", "test"), help="the record's split")
+    parser.add_argument("--split", default=SOLAR_EVAL_SPLIT, choices=SOLAR_SPLITS, help="the record's split")
     parser.add_argument(
         "--mission", type=int, default=None, help="the mission drawn (an index); None: where dp leads ppo most"
     )

@@ -124,7 +124,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         policy_width,
         summarize,
     )
-    from orbit_env.agents.solar import SOLAR_HAND_CODED, evaluate_solar, solar_report
+    from orbit_env.agents.solar import evaluate_solar, solar_report
     from orbit_env.envs import SOLAR_CONTINUOUS_ENV_ID
 
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
@@ -150,7 +150,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     # Episode by episode: the optimum against the best operators' rule (the task's headroom), the learned
     # agent against that rule and against the optimum. The JSON keys mean what they mean for every env:
     # paired_difference the learned agent less the best rule, paired_to_dp the learned agent less the DP.
-    best_rule = max(SOLAR_HAND_CODED, key=lambda name: results[name].returns.mean())
+    best_rule = max(evaluation.rules, key=lambda name: results[name].returns.mean())
     agent = next(iter(learned), None)
     pairs = {
         "paired_dp": paired_difference(results, name="dp", baseline=best_rule),
@@ -318,8 +318,8 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--solar-split",
         choices=SOLAR_SPLITS,
-        help=f"the solar task: the record's split the missions are drawn from (default {SOLAR_EVAL_SPLIT}: "
-        "cycles 24-25)",
+        help=f"the solar task: the record's split the missions are drawn from (default {SOLAR_EVAL_SPLIT}; "
+        "train: cycles 19-23, test: cycles 24-25)",
     )
     ev.add_argument(
         "--disposal-years",

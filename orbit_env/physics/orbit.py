@@ -96,11 +96,13 @@ def perigee_velocity_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike) -> FloatArra
 
 
 def air_speed_at_perigee_m_s(perigee_m: ArrayLike, apogee_m: ArrayLike, inclination_deg: ArrayLike) -> FloatArray:
-    """Speed at perigee through air co-rotating with the Earth [m/s]: v_pi - Omega r_p cos i.
+    """Along-track speed at perigee relative to air co-rotating with the Earth [m/s]: v_pi - Omega r_p cos i.
 
     The air's eastward speed Omega r cos(latitude), projected on a track of inclination i
     (whose eastward share at that latitude is cos i / cos(latitude)), is Omega r cos i at any
-    latitude. ``inclination_deg`` broadcasts against the heights.
+    latitude. The wind across the track (up to Omega r sin i, some 10 m/s of the relative
+    speed's magnitude at 53 deg) is left out, as in King-Hele's theory of orbits in a rotating
+    atmosphere. ``inclination_deg`` broadcasts against the heights.
     """
     wind = EARTH_ROTATION_RAD_S * np.add(perigee_m, EARTH_RADIUS_M)
     return perigee_velocity_m_s(perigee_m, apogee_m) - wind * np.cos(np.radians(inclination_deg))

@@ -11,12 +11,16 @@ from orbit_env.agents import solar
 from orbit_env.envs import SOLAR_CONTINUOUS_ENV_ID, SOLAR_ENV_ID, solar_task
 from orbit_env.envs.solar_task import SolarMission, SolarTask
 
-#: Fixed thresholds (the tuning itself is not what these tests check: it takes 30 s).
-SETTINGS = {"perigee_threshold": (420.0, 40.0), "life_threshold": (1.0, 20.0)}
+#: Fixed thresholds (the tuning itself is not what these tests check: it takes 30 s), high enough that every
+#: rule burns on the missions flown here (checked).
+SETTINGS = {"perigee_threshold": (450.0, 0.0), "life_threshold": (3.0, 0.0)}
 
 
 def _rules(task: SolarTask) -> list[solar.Never]:
-    return [rule(task) if rule.grid is None else rule(task, *SETTINGS[rule.name]) for rule in solar.SOLAR_RULES]
+    return [
+        rule(task, *SETTINGS[rule.name]) if issubclass(rule, solar.Threshold) else rule(task)
+        for rule in solar.SOLAR_RULES
+    ]
 
 
 @pytest.mark.parametrize("env_id", [SOLAR_ENV_ID, SOLAR_CONTINUOUS_ENV_ID])
@@ -32,6 +36,8 @@ def test_each_rule_flown_by_predict_in_the_environment_returns_what_fly_gives(en
     env = gymnasium.make(env_id, solar_split="test")
     for rule in _rules(task):
         flown = solar.fly(task, options, solar.by_observation(task, rule))
+        if rule.name != "never":  # every other rule burns on these missions: its predict is tested burning
+            assert (flown.dv_m_s - flown.disposal_m_s).max() > 0.0, rule.name
         for i in range(2):
             obs, _ = env.reset(options={key: float(value[i]) for key, value in options.items()})
             total, done = 0.0, False
@@ -43,13 +49,19 @@ def test_each_rule_flown_by_predict_in_the_environment_returns_what_fly_gives(en
             assert total == pytest.approx(flown.returns[i], abs=1e-9), rule.name
 
 
-def test_predict_takes_a_batch_and_refuses_another_shape():
-    task = SolarTask(mission=SolarMission(solar_split="test"))
+@pytest.mark.parametrize("continuous", [False, True])
+def test_predict_takes_one_observation_or_a_batch_as_sb3_does_and_refuses_another_shape(continuous):
+    """SB3's shapes: a batch of n gives (n,) indices or (n, 1) Box values; one observation () or (1,)."""
+    task = SolarTask(mission=SolarMission(solar_split="test"), continuous=continuous)
     obs = solar_task.observe(task, solar_task.start(task, np.random.default_rng(3), 4))
+    sizes = np.asarray(task.config.burn_sizes_m_s)
     for rule in _rules(task):
-        actions, state = rule.predict(obs)
-        assert state is None
-        np.testing.assert_array_equal(actions, rule.actions(obs))
+        actions, _ = rule.predict(obs)
+        single, _ = rule.predict(obs[0])
+        assert actions.shape == ((4, 1) if continuous else (4,)) and single.shape == ((1,) if continuous else ())
+        burns = task.requested_dvs(actions, 4)  # as the environment reads the actions
+        np.testing.assert_array_equal(burns, sizes[rule.actions(obs)])
+        np.testing.assert_array_equal(single, actions[0])
     with pytest.raises(ValueError, match=r"shape \(11,\) or \(n, 11\), got shape \(4, 7\)"):
         solar.Never(task).predict(obs[:, :7])
 
@@ -64,8 +76,25 @@ def test_a_rule_added_to_the_registry_is_scored_beside_the_others(monkeypatch):
             return np.ones(len(obs), dtype=np.int64)
 
     monkeypatch.setattr(solar, "SOLAR_RULES", (*solar.SOLAR_RULES, Half))
-    monkeypatch.setattr(solar, "SOLAR_HAND_CODED", (*solar.SOLAR_HAND_CODED, "half"))
     monkeypatch.setattr(solar, "tune", lambda task: SETTINGS)
     evaluation = solar.evaluate_solar(2, 11, include_dp=False)
-    assert list(evaluation.flown) == [*solar.SOLAR_HAND_CODED]
-    assert evaluation.flown["half"].dv_m_s.min() > 0.0  # it burned
+    assert list(evaluation.flown) == [*solar.SOLAR_HAND_CODED, "half"] == list(evaluation.rules)
+    assert (evaluation.flown["half"].dv_m_s - evaluation.flown["half"].disposal_m_s).min() > 0.0  # it burned
+    assert set(solar.solar_report(evaluation)["policies"]) == set(evaluation.flown)
+
+
+def test_a_tuned_rule_added_to_the_registry_is_tuned(monkeypatch):
+    """A `Threshold` rule added to `SOLAR_RULES` has its grid tuned (the tuning's cache keys on the rules)."""
+
+    class Apogee(solar.Threshold):
+        name = "apogee_threshold"
+        grid = (500.0,)
+
+        def actions(self, obs):
+            return np.zeros(len(obs), dtype=np.int64)
+
+    monkeypatch.setattr(solar, "SOLAR_RULES", (solar.Never, Apogee))
+    monkeypatch.setattr(solar, "TUNE_EPISODES", 2)
+    task = SolarTask(mission=SolarMission(solar_split="test"))
+    assert solar.tune(task) == {"apogee_threshold": (500.0, 0.0)}  # every reserve ties: the first one kept
+    assert isinstance(solar.hand_coded(task)["apogee_threshold"], Apogee)
