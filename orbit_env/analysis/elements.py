@@ -217,8 +217,12 @@ class BadSet(NamedTuple):
     message: str  # what is wrong, naming the line (without the file's name)
 
 
-def parse_tle_text(lines: Iterable[str], source: str = "TLE", bad: list[BadSet] | None = None) -> list[ElementSet]:
+def parse_tle_text(
+    lines: str | Iterable[str], source: str = "TLE", bad: list[BadSet] | None = None
+) -> list[ElementSet]:
     """Every element set of a text in CelesTrak's format: two-line sets, or three-line sets with a name line.
+
+    ``lines``: the text's lines, or the text itself (one string).
 
     Text as people paste it is read: lines may be indented, end in spaces, tabs or CRLF,
     and a set may have no name line. Blank lines are skipped; a name line is any line that
@@ -229,6 +233,8 @@ def parse_tle_text(lines: Iterable[str], source: str = "TLE", bad: list[BadSet] 
     Raises:
         ValueError: a malformed set (the message names the file's line and what is wrong), or no set at all.
     """
+    if isinstance(lines, str):
+        lines = lines.splitlines()
     numbered = [(i + 1, text.strip()) for i, text in enumerate(lines)]
     numbered = [(i, text) for i, text in numbered if text.strip()]
     sets: list[ElementSet] = []

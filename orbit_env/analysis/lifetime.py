@@ -7,6 +7,7 @@ This is the public edge, so heights are in km and every input is checked here
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
@@ -29,7 +30,7 @@ from orbit_env.decay.curves import (
     universal_curves,
 )
 from orbit_env.decay.reference_path import reference_path
-from orbit_env.decay.solar import ConstantActivity, SolarActivity, TableActivity, unix_days
+from orbit_env.decay.solar import ConstantActivity, SolarActivity, SolarTableWarning, TableActivity, unix_days
 from orbit_env.physics.atmosphere import Atmosphere, as_atmosphere
 from orbit_env.physics.orbit import elements_from_heights, perigee_velocity_m_s, period_s, validate_heights_km
 from orbit_env.physics.satellite_bounds import (
@@ -146,7 +147,7 @@ class LifetimeResult:
     days: float
     perigee_velocity_m_s: float
     method: str
-    history: DecayHistory = field(repr=False)
+    history: DecayHistory = field(repr=False, compare=False)  # equal results: equal numbers
     reentered: bool = True
     epoch_days: float | None = None
 
@@ -181,7 +182,11 @@ class LifetimeResult:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """The result without the history, JSON-ready."""
+        """The result without the history, JSON-ready; its heights above the 6371 km sphere (``height_reference``).
+
+        The command line reports the heights as they were typed, in their reference (``equatorial``
+        for NRLMSIS and a date: above 6378.137 km), under the same key.
+        """
         return {
             "perigee_km": self.perigee_km,
             "apogee_km": self.apogee_km,
@@ -195,6 +200,7 @@ class LifetimeResult:
             **({} if self.reentered else {"years_reached": self.days / DAYS_PER_YEAR}),
             **({} if self.epoch_days is None else {"epoch": iso_datetime(self.epoch_days)}),
             **({} if self.reentry_date is None else {"reentry_date": self.reentry_date}),
+            "height_reference": "sphere",  # lifetime() takes heights above the sphere
         }
 
 
@@ -236,7 +242,7 @@ def lifetime(
     activity: SolarActivity | None = None,
     epoch: str | float | None = None,
     ascending_node_local_time_h: float | None = None,
-    chunk_days: float = DEFAULT_CHUNK_DAYS,
+    chunk_days: float | None = None,
 ) -> LifetimeResult:
     """Lifetime of a satellite from perigee/apogee heights to re-entry (perigee 100 km).
 
@@ -274,7 +280,14 @@ def lifetime(
             with the season averaged (use ``CycleActivity.with_phase(phase, 0.0)``).
         ascending_node_local_time_h: NRLMSIS, Sun-synchronous orbits: the node's
             local solar time (else local time is averaged over).
-        chunk_days: Time step of the time-stepped path.
+        chunk_days: Time step [days] of the time-stepped path (None: `DEFAULT_CHUNK_DAYS`); a keyword
+            of the air like the others (a scenario carries its own), for a time-stepped decay only.
+
+    Raises:
+        TypeError: more than one orbit (arrays: see `Scenario.lifetime_days`), or a satellite or
+            scenario of another type.
+        ValueError: a height, method or keyword out of range, the air given twice, a keyword
+            that does nothing here.
 
     Examples:
         >>> result = lifetime(360, 800)
@@ -283,8 +296,18 @@ def lifetime(
     """
     if method is not None and method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if np.ndim(perigee_km) or np.ndim(apogee_km):
+        raise TypeError(
+            f"lifetime() decays one orbit: perigee_km and apogee_km must be numbers, got shapes "
+            f"{np.shape(perigee_km)} and {np.shape(apogee_km)}; many orbits: Scenario.lifetime_days or "
+            "orbit_env.analysis.catalogue.batch_lifetimes"
+        )
     hp_m, ha_m = (float(x) for x in validate_heights_km(perigee_km, apogee_km))
-    satellite = satellite or Satellite()
+    satellite = Satellite() if satellite is None else satellite
+    if not isinstance(satellite, Satellite):
+        raise TypeError(f"satellite must be a Satellite (orbit_env.Satellite), got {type(satellite).__name__}")
+    if scenario is not None and not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario must be a Scenario (orbit_env.analysis.scenario), got {type(scenario).__name__}")
     keywords = {
         "rho100_kg_m3": rho100_kg_m3,
         "atmosphere": atmosphere,
@@ -294,15 +317,28 @@ def lifetime(
         "ascending_node_local_time_h": ascending_node_local_time_h,
     }
     if scenario is None:
-        scenario = scenario_from_keywords(density_scale=density_scale, chunk_days=chunk_days, **keywords)
-    elif any(value is not None for value in keywords.values()) or density_scale != 1.0:
-        given = ", ".join(name for name, value in keywords.items() if value is not None) or "density_scale"
+        step = DEFAULT_CHUNK_DAYS if chunk_days is None else chunk_days
+        scenario = scenario_from_keywords(density_scale=density_scale, chunk_days=step, **keywords)
+        if chunk_days is not None and not scenario.time_varying:
+            raise ValueError(
+                f"chunk_days={chunk_days!r} steps a dated decay (an epoch, or activity that changes); this air is "
+                "one fixed profile"
+            )
+    elif any(value is not None for value in {**keywords, "chunk_days": chunk_days}.values()) or density_scale != 1.0:
+        named = {**keywords, "chunk_days": chunk_days}
+        given = ", ".join(name for name, value in named.items() if value is not None) or "density_scale"
         raise ValueError(f"give the air either as a scenario or as keywords, not both (here: scenario and {given})")
     method = method or default_method(scenario, hp_m, ha_m)
     if scenario.time_varying:
-        return _lifetime_under_activity(
+        result = _lifetime_under_activity(
             hp_m, ha_m, satellite, method, scenario.density_scale, scenario.solar_model(inclination_deg)
         )
+        solar = scenario.activity
+        if isinstance(solar, TableActivity) and scenario.epoch_days is not None:
+            held = solar.held_outside(scenario.epoch_days, scenario.epoch_days + result.days)
+            if held is not None:
+                warnings.warn(held, SolarTableWarning, stacklevel=2)
+        return result
     atmosphere = scenario.air.profile(inclination_deg, scenario.density_scale)
     rho_perigee = float(np.asarray(atmosphere.density_kg_m3(hp_m)))
     if not (math.isfinite(rho_perigee) and rho_perigee > 0.0):
@@ -477,19 +513,21 @@ def _lifetime_under_activity(
         hp_path = np.append(result.history_perigee_m[inside, 0], result.history_perigee_m[-1, 0])
         ha_path = np.append(result.history_apogee_m[inside, 0], result.history_apogee_m[-1, 0])
     # Still up at max_years is a result (reentered False), reported as the years reached.
-    # Revolutions: Int dt / P, trapezoidal over the recorded orbits (the period changes slowly).
+    # Revolutions: Int dt / P, trapezoidal over the recorded orbits (the period changes slowly), to each row.
     if np.all(np.isfinite(ha_path)):
         inverse_period = 1.0 / period_s(*elements_from_heights(hp_path, ha_path))
-        revolutions = float(np.sum(0.5 * (inverse_period[1:] + inverse_period[:-1]) * np.diff(t)) * SECONDS_PER_DAY)
-    else:
-        revolutions = float(days * SECONDS_PER_DAY / period_s(*elements_from_heights(hp_m, ha_m)))
+        steps = 0.5 * (inverse_period[1:] + inverse_period[:-1]) * np.diff(t) * SECONDS_PER_DAY
+        counted = np.concatenate([[0.0], np.cumsum(steps)])
+    else:  # no finite path (an orbit beyond the curves' heights): at the starting period
+        counted = t * (SECONDS_PER_DAY / period_s(*elements_from_heights(hp_m, ha_m)))
+    revolutions = float(counted[-1])
     nu = revolutions / per_nu
     history = DecayHistory(
-        revolutions=np.linspace(0.0, revolutions, t.size),
+        revolutions=counted,
         days=t,
         perigee_km=hp_path / 1e3,
         apogee_km=ha_path / 1e3,
-        nu_remaining=np.linspace(nu, 0.0, t.size),
+        nu_remaining=(revolutions - counted) / per_nu,
     )
     result = LifetimeResult.from_si(hp_m, ha_m, nu, revolutions, days, method, history)
     epoch = model.start_days if model.follow_season else None

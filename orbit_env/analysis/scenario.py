@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.analysis.air import Air, PaperAir
-from orbit_env.checks import check_number
+from orbit_env.checks import check_array, check_number
 from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
 from orbit_env.decay.averaged import DecayModel
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS, DEFAULT_MAX_YEARS, SolarDecayModel, propagate
@@ -21,6 +21,7 @@ from orbit_env.decay.curves import UniversalCurves, days_from_weighted_s
 from orbit_env.decay.solar import SolarActivity, iso_date
 from orbit_env.physics.atmosphere import Atmosphere
 from orbit_env.physics.atmosphere.paper import RHO100_CALIBRATED_KG_M3
+from orbit_env.physics.satellite_bounds import DRAG_PARAMETER_RANGE_M2_KG
 
 FloatArray = NDArray[np.float64]
 #: Bounds of a density scale factor, and why.
@@ -177,14 +178,15 @@ class Scenario:
         ``inclination_deg`` (`orbit_env.decay.chunked.propagate`).
 
         Raises:
-            ValueError: heights invalid or outside the universal curves' domain, or
-                ``own_inclination_deg`` on a fixed profile (the catalogue's one-family
-                path serves those).
+            ValueError: heights invalid or outside the universal curves' domain, a drag parameter or
+                density scale out of range, or ``own_inclination_deg`` on a fixed profile (the
+                catalogue's one-family path serves those).
         """
         hp, ha = UniversalCurves.check_domain(perigee_m, apogee_m)
-        hp, ha, c, s = np.broadcast_arrays(
-            hp, ha, np.asarray(drag_parameter_m2_kg, dtype=np.float64), np.asarray(density_scale, dtype=np.float64)
-        )
+        low, high, why = DRAG_PARAMETER_RANGE_M2_KG
+        c = check_array(drag_parameter_m2_kg, "drag_parameter_m2_kg", unit="m^2/kg", low=low, high=high, why=why)
+        s = check_array(density_scale, "density_scale", low=0.0, low_inclusive=False)
+        hp, ha, c, s = np.broadcast_arrays(hp, ha, c, s)
         s = s * self.density_scale
         if not self.time_varying:
             if own_inclination_deg is not None:

@@ -48,8 +48,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from orbit_env.analysis.scenario import Scenario
 from orbit_env.checks import check_int, check_number
 from orbit_env.constants import DAYS_PER_YEAR
+from orbit_env.decay.curves import UniversalCurves
+from orbit_env.physics.satellite_bounds import DRAG_PARAMETER_RANGE_M2_KG
 
 FloatArray = NDArray[np.float64]
 
@@ -185,7 +188,16 @@ def lifetime_spread(
         drag_sigma: Log-normal sigma of the drag parameter: `DRAG_COEFFICIENT_SIGMA` for a
             satellite of known mass and area, `ONE_SET_DRAG_SIGMA` for one element set's.
         workers: Processes for the solar nodes (`propagate_nodes`); the results do not depend on it.
+
+    Raises:
+        ValueError: heights outside the universal curves' domain (metres, not km), a drag parameter
+            out of range, or not a `Scenario`.
     """
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario must be a Scenario (orbit_env.analysis.scenario), got {type(scenario).__name__}")
+    UniversalCurves.check_domain(perigee_m, apogee_m)  # the samples decay on the curves, dated or not
+    low, high, why = DRAG_PARAMETER_RANGE_M2_KG
+    check_number(drag_parameter_m2_kg, "drag_parameter_m2_kg", unit="m^2/kg", low=low, high=high, why=why)
     z_sun, density, drag = sample_factors(samples, seed, drag_sigma)
     scale = density * drag
     drag_key = "drag_coefficient" if drag_sigma == DRAG_COEFFICIENT_SIGMA else "drag_parameter"

@@ -12,6 +12,7 @@ import json
 import math
 import sys
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -45,6 +46,7 @@ from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.chunked import DEFAULT_CHUNK_DAYS
 from orbit_env.decay.solar import (
     DEFAULT_AP,
+    SolarTableWarning,
     TableActivity,
     iso_date,
     unix_days,
@@ -110,22 +112,11 @@ def _warn_solar_table(scenario: Scenario, last_day: float) -> None:
     extend a table, extend it in `_scenario` and say so here instead.
     """
     solar = scenario.activity
-    if not isinstance(solar, TableActivity) or scenario.epoch_days is None or not math.isfinite(last_day):
+    if not isinstance(solar, TableActivity) or scenario.epoch_days is None:
         return
-    held = []
-    if scenario.epoch_days < solar.start_days - 1.0:
-        held.append(f"starts on {iso_date(solar.start_days)}, after the epoch {iso_date(scenario.epoch_days)}")
-    if last_day > solar.end_days + 1.0:
-        held.append(
-            f"ends on {iso_date(solar.end_days)}, {last_day - solar.end_days:.0f} days before the re-entry on "
-            f"{iso_date(last_day)}"
-        )
-    if held:
-        print(
-            f"{PROG}: warning: the solar table {solar.source} {' and '.join(held)}; its edge rows were held "
-            "constant outside it (no record or forecast beyond the table is used)",
-            file=sys.stderr,
-        )
+    text = solar.held_outside(scenario.epoch_days, last_day)
+    if text is not None:
+        print(f"{PROG}: warning: {text}", file=sys.stderr)
 
 
 def _check_inclination(args: argparse.Namespace) -> None:
@@ -195,9 +186,16 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if args.uncertainty:
         _check_on_the_curves(perigee_km, apogee_km, offset)
     air = scenario.in_sphere_heights(orbit.reference, args.inclination)
-    result = lifetime(
-        perigee_km, apogee_km, satellite=satellite, scenario=air, method=args.method, inclination_deg=args.inclination
-    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SolarTableWarning)  # said below, as the command's warnings are
+        result = lifetime(
+            perigee_km,
+            apogee_km,
+            satellite=satellite,
+            scenario=air,
+            method=args.method,
+            inclination_deg=args.inclination,
+        )
     if scenario.epoch_days is not None:
         _warn_solar_table(scenario, scenario.epoch_days + result.days)
     summary = result.to_dict()
@@ -211,7 +209,9 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
         **drag.report,
     )
     if orbit.elements is not None:
-        summary.update(orbit_inputs.elements_report(orbit.elements, result))
+        from orbit_env.analysis.element_set_lifetime import elements_report
+
+        summary.update(elements_report(orbit.elements, result))
     rule = None
     if args.rule is not None:
         rule = check_rule(

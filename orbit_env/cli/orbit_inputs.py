@@ -264,25 +264,6 @@ def satellite_from_args(args: argparse.Namespace, orbit: OrbitInput, scenario: A
     )
 
 
-def elements_report(elements: Any, result: Any = None) -> dict[str, Any]:
-    """What JSON says about an element set (and the re-entry date from its epoch, if the decay had none)."""
-    from orbit_env.analysis.lifetime import iso_datetime
-
-    report: dict[str, Any] = {
-        "semi_major_axis_km": elements.semi_major_axis_km,
-        "eccentricity": elements.eccentricity,
-        "mean_perigee_km": elements.perigee_km,
-        "mean_apogee_km": elements.apogee_km,
-        "flown_offset_km": elements.flown_offset_km,
-    }
-    if elements.epoch_days is not None:
-        report.update(name=elements.name, epoch=elements.epoch_iso)
-        if result is not None and result.epoch_days is None and result.reentered:
-            # A fixed atmosphere (no date in the decay): the element set's epoch still dates the re-entry.
-            report["reentry_date"] = iso_datetime(elements.epoch_days + result.days)
-    return report
-
-
 def orbit_lines(orbit: OrbitInput, inclination_deg: float) -> list[str]:
     """The text output's lines about the orbit."""
     from orbit_env.analysis.heights import describe

@@ -119,6 +119,10 @@ class ConstantActivity:
         return np.full(shape, self.f107_sfu), np.full(shape, self.f107a_sfu), np.full(shape, self.ap)
 
 
+class SolarTableWarning(UserWarning):
+    """A decay ran beyond a solar table's rows, on its edge rows held (`TableActivity.held_outside`)."""
+
+
 @dataclass(frozen=True, eq=False)
 class TableActivity:
     """Indices by date, linearly interpolated; the first and last rows are held outside.
@@ -163,6 +167,26 @@ class TableActivity:
     def end_days(self) -> float:
         """Unix day of the last row."""
         return float(self.days[-1])
+
+    def held_outside(self, first_day: float, last_day: float) -> str | None:
+        """Why a decay from ``first_day`` to ``last_day`` [unix days] is not covered by the table, or None if it is.
+
+        Outside its rows the first or last row is held; the sentence gives the dates and says so.
+        """
+        held = []
+        if first_day < self.start_days - 1.0:
+            held.append(f"starts on {iso_date(self.start_days)}, after the epoch {iso_date(first_day)}")
+        if math.isfinite(last_day) and last_day > self.end_days + 1.0:
+            held.append(
+                f"ends on {iso_date(self.end_days)}, {last_day - self.end_days:.0f} days before the re-entry on "
+                f"{iso_date(last_day)}"
+            )
+        if not held:
+            return None
+        return (
+            f"the solar table {self.source} {' and '.join(held)}; its edge rows were held constant outside it "
+            "(no record or forecast beyond the table is used)"
+        )
 
     def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Indices interpolated at ``days`` (held at the edges)."""

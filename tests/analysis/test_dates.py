@@ -61,3 +61,23 @@ def test_plot_carries_dates_and_the_sun(capsys, tmp_path):
     path = tmp_path / "decay.png"
     status, _, _ = run(capsys, *ORBIT, *CUBESAT, "--epoch", "2015-05-01", "--plot", str(path))
     assert status == 0 and path.stat().st_size > 10_000
+
+
+def test_a_dated_decays_history_counts_the_revolutions_each_row_has_flown():
+    """The rows are days apart (20-day steps, then daily near re-entry): each row's revolutions are those flown.
+
+    Independently of the trapezoid: between two rows the revolutions flown lie between the days
+    over the longer and over the shorter of the two rows' periods (the period only falls).
+    """
+    from orbit_env import Satellite, lifetime
+    from orbit_env.physics.orbit import elements_from_heights, period_s
+
+    result = lifetime(450, 450, satellite=Satellite(2.2, 4.0, 0.03), epoch="2015-05-01", inclination_deg=51.6)
+    history = result.history
+    gaps = np.diff(history.days)
+    assert gaps.max() > 10.0 > 2.0 > gaps.min()  # uneven rows: a row is not a fixed share of the revolutions
+    period = period_s(*elements_from_heights(history.perigee_km * 1e3, history.apogee_km * 1e3)) / 86400.0
+    flown = np.diff(history.revolutions)
+    assert np.all(flown >= gaps / period[:-1] * (1 - 1e-12)) and np.all(flown <= gaps / period[1:] * (1 + 1e-12))
+    assert history.revolutions[-1] == result.revolutions and history.revolutions[0] == 0.0
+    assert history.nu_remaining[0] == pytest.approx(result.nu, rel=1e-12) and history.nu_remaining[-1] == 0.0

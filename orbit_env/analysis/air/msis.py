@@ -77,6 +77,13 @@ class MsisAir(Air):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "version", check_msis_version(self.version))
+        if self.epoch_days is not None:
+            if isinstance(self.epoch_days, str):
+                text = self.epoch_days
+                raise TypeError(f"epoch_days={text!r} must be unix days (orbit_env.decay.solar.unix_days({text!r}))")
+            first = getattr(self.activity, "start_days", None)  # a table may start before Sputnik (the record: 3 days)
+            if first is None or self.epoch_days != first:
+                object.__setattr__(self, "epoch_days", check_date(self.epoch_days, "epoch_days"))
         if self.epoch_days is None and self.activity is not None and not isinstance(self.activity, ConstantActivity):
             raise ValueError("activity that changes with time needs an epoch (a start date)")
 
