@@ -9,10 +9,12 @@ its version and `FORMAT_VERSION`), so a stale table is never read; in it a table
 of its kind and a description of its inputs (the ``repr`` of frozen dataclasses of plain numbers).
 
 Old generations do not pile up: the first write of a process deletes the generations other
-than its own and the `KEEP_GENERATIONS` - 1 used last (a generation is used when a process
-reads or writes it: two installed versions taking turns keep their tables), and the tables of
-the layout before generations (``<kind>-<hash>`` at the folder's top). Nothing else in the
-folder is touched (`prune`).
+than its own and the `KEEP_GENERATIONS` - 1 used last, but never one used within `IN_USE_S` (a
+process marks its generation used as it reads and writes, at most once a minute: a long run, or
+two installed versions taking turns, keep their tables), and the tables of the layout before
+generations (``<kind>-<hash>`` at the folder's top, of this package's kinds) not written within
+`FLAT_KEPT_S`. Nothing else in the folder is touched: a generation is deleted only if it holds
+the marker this module writes; what cannot be deleted stays (`prune`).
 
 Writes are atomic: a table is written to a temporary file in the same folder and
 renamed over its name, so processes that race build the same table twice at most
@@ -32,10 +34,12 @@ import contextlib
 import dataclasses
 import functools
 import hashlib
+import math
 import os
 import re
 import shutil
 import tempfile
+import time
 import zipfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -56,17 +60,25 @@ ENV_VAR = "ORBIT_ENV_CACHE_DIR"
 FORMAT_VERSION = 1
 #: Generations kept in the cache folder by `prune`: this process's and those used last.
 KEEP_GENERATIONS = 3
+#: A generation used this recently [s] is in use (a process marks its own at most a minute apart): never pruned.
+IN_USE_S = 3600.0
+#: Tables of the layout before generations written this recently [s] are kept (a checkout of then may still run).
+FLAT_KEPT_S = 7 * 86400.0
+#: A process marks its generation used at most this often [s].
+MARK_EVERY_S = 60.0
+#: The kinds of table this package caches: a flat table's name starts with one.
+KINDS = ("airdays", "curves", "dp", "fit", "msis", "record")
 #: A generation's folder, and a table of the layout before generations (a file, its lock or a folder of arrays).
 _GENERATION_NAME = re.compile(r"v-[0-9a-f]{16}")
-_FLAT_TABLE_NAME = re.compile(r"[a-z]+-[0-9a-f]{24}(\.npz|\.lock)?")
-#: A generation's marker file, touched when a process first reads or writes it: its time is the generation's last use.
+_FLAT_TABLE_NAME = re.compile(rf"({'|'.join(KINDS)})-[0-9a-f]{{24}}(\.npz|\.lock)?")
+#: A generation's marker file, touched as a process reads and writes it: its time is the generation's last use.
 _USED = ".used"
 
 #: Values of an ``ORBIT_ENV_*`` setting (this one, `orbit_env.workers.FORK_ENV_VAR`) that turn it off.
 OFF_SETTINGS = ("off", "0", "false", "no")
 
 _disabled = False
-_marked: set[Path] = set()  # generation folders this process has marked used
+_marked: dict[Path, float] = {}  # generation folders this process has marked used, and when
 _pruned: set[Path] = set()  # cache folders this process has pruned
 
 
@@ -143,49 +155,61 @@ def generation_dir() -> Path | None:
 
 
 def prune(folder: Path, keep: int = KEEP_GENERATIONS) -> list[Path]:
-    """Delete from a cache folder the generations but this version's and the ``keep`` - 1 used last, and flat tables.
+    """Delete from a cache folder old generations and flat tables (the module docstring says which); return them.
 
-    Flat tables are the layout's before generations (``<kind>-<24 hex digits>`` at the top).
-    Anything else in ``folder`` stays; what cannot be deleted (in use elsewhere, no permission)
-    stays too. Returns the entries deleted.
+    A generation (``v-`` and 16 hex digits, a folder with this module's marker) goes when it is
+    neither this version's, nor among the ``keep`` - 1 others used last, nor used within `IN_USE_S`.
+    A flat table (the layout's before generations: one of `KINDS`, a hyphen and 24 hex digits, a
+    file, its lock, or a folder of ``.npy`` arrays) goes when not written within `FLAT_KEPT_S`.
+    Anything else stays, and so does what cannot be deleted (in use elsewhere, no permission).
     """
     own = f"v-{_generation()}"
+    now = time.time()
     older: list[tuple[float, Path]] = []
-    removed: list[Path] = []
+    doomed: list[Path] = []
     try:
         entries = list(folder.iterdir())
     except OSError:
-        return removed
+        return doomed
     for entry in entries:
-        if _GENERATION_NAME.fullmatch(entry.name) and entry.name != own and entry.is_dir():
-            older.append((_last_used(entry), entry))
-        elif _FLAT_TABLE_NAME.fullmatch(entry.name):
-            removed.append(entry)
+        try:
+            if entry.is_symlink():
+                continue
+            if _GENERATION_NAME.fullmatch(entry.name) and entry.name != own and (entry / _USED).is_file():
+                older.append((_last_used(entry), entry))
+            elif _FLAT_TABLE_NAME.fullmatch(entry.name) and now - entry.stat().st_mtime > FLAT_KEPT_S:
+                arrays = not entry.is_dir() or all(f.suffix == ".npy" for f in entry.iterdir())
+                if arrays:
+                    doomed.append(entry)
+        except OSError:
+            continue
     older.sort(reverse=True)
-    removed += [entry for _, entry in older[max(keep - 1, 0) :]]
-    for entry in removed:
-        if entry.is_dir():
-            shutil.rmtree(entry, ignore_errors=True)
-        else:
-            entry.unlink(missing_ok=True)
+    doomed += [entry for used, entry in older[max(keep - 1, 0) :] if now - used > IN_USE_S]
+    removed = []
+    for entry in doomed:
+        with contextlib.suppress(OSError):
+            if entry.is_dir():
+                shutil.rmtree(entry)
+            else:
+                entry.unlink()
+            removed.append(entry)
     return removed
 
 
 def _last_used(generation: Path) -> float:
-    """When a generation folder was last read or written (its marker's time; the folder's without one)."""
-    for path in (generation / _USED, generation):
-        try:
-            return path.stat().st_mtime
-        except OSError:
-            continue
-    return 0.0
+    """When a generation folder was last read or written (its marker's time)."""
+    try:
+        return (generation / _USED).stat().st_mtime
+    except OSError:
+        return 0.0
 
 
 def _mark_used(generation: Path) -> None:
-    """Touch a generation's marker, once per process (`prune` keeps the generations used last)."""
-    if generation in _marked or not generation.is_dir():
+    """Touch a generation's marker, at most every `MARK_EVERY_S` in a process (`prune` keeps those in use)."""
+    now = time.monotonic()
+    if now - _marked.get(generation, -math.inf) < MARK_EVERY_S or not generation.is_dir():
         return
-    _marked.add(generation)
+    _marked[generation] = now
     with contextlib.suppress(OSError):
         (generation / _USED).touch()
 

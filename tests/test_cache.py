@@ -1,6 +1,8 @@
 """The disk cache of long-built tables (orbit_env.cache): keyed by their inputs, atomic, movable, can be disabled."""
 
 import os
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -98,32 +100,73 @@ def test_the_default_curves_are_one_table_in_a_process():
 
 
 def test_old_generations_and_flat_tables_are_pruned_and_nothing_else(folder):
-    """The first write of a process keeps its generation and the two others used last; a user's files stay."""
-    import time
+    """The first write of a process keeps its generation, the two others used last and any in use; a user's stay."""
+    hour = 3600.0
+    now = time.time()
 
-    stale = []
-    for age in range(4):  # four other versions' folders, the oldest used 4 hours ago
-        generation = folder / f"v-{age:016x}"
+    def aged(path, hours):
+        os.utime(path, (now - hours * hour, now - hours * hour))
+        return path
+
+    used_hours = [1 / 12, 1 / 3, 2 / 3, 2.0, 3.0]  # five other versions' folders, by when they were last used
+    others = []
+    for k, hours in enumerate(used_hours):
+        generation = folder / f"v-{k:016x}"
         generation.mkdir()
         (generation / "curves-0123.npz").write_bytes(b"x")
         (generation / ".used").touch()
-        used = time.time() - 3600.0 * (age + 1)
-        os.utime(generation / ".used", (used, used))
-        stale.append(generation)
+        aged(generation / ".used", hours)
+        others.append(generation)
+    # Kept: the two used last (5 and 20 minutes ago), and the one used 40 minutes ago (in use: a long run).
+    kept_others, stale = others[:3], others[3:]
+    week = 24 * 8
     flat = [folder / f"dp-{'a' * 24}.npz", folder / f"curves-{'b' * 24}", folder / f"msis-{'c' * 24}.lock"]
     flat[0].write_bytes(b"x")
     flat[1].mkdir()
+    (flat[1] / "a.npy").write_bytes(b"x")
     flat[2].write_bytes(b"")
+    for path in flat:
+        aged(path, week)
+    recent_flat = folder / f"dp-{'d' * 24}.npz"  # written by a checkout of the old layout this week: kept
+    recent_flat.write_bytes(b"x")
     mine = [folder / "notes.txt", folder / "v-not-a-generation", folder / "dp-123.npz"]
+    mine += [folder / f"user-{'e' * 24}", folder / f"curves-{'f' * 24}", folder / f"v-{'1' * 16}"]
     mine[0].write_text("a user's file")
     mine[1].mkdir()
     mine[2].write_bytes(b"x")
+    mine[3].mkdir()  # a name like a table's but no kind of this package's
+    mine[4].mkdir()  # a kind's name, but a folder holding what no table holds
+    (mine[4] / "important.json").write_text("{}")
+    mine[5].mkdir()  # a generation's name without this module's marker
+    for path in mine:
+        aged(path, week)
     cache.store("dp", "a pruning test", {"values": np.arange(3.0)})  # the first write into this (new) folder
     kept = sorted(p.name for p in folder.iterdir())
     own = cache.generation_dir().name
-    assert kept == sorted([own, stale[0].name, stale[1].name, *(p.name for p in mine)])
+    expected = [own, *(p.name for p in kept_others), recent_flat.name, *(p.name for p in mine)]
+    assert kept == sorted(expected)
+    assert (mine[4] / "important.json").is_file()
     assert cache.load("dp", "a pruning test")["values"].tolist() == [0.0, 1.0, 2.0]
     # Once a process: a later write does not prune again.
-    (folder / stale[3].name).mkdir()
+    stale[0].mkdir()
+    (stale[0] / ".used").touch()
+    aged(stale[0] / ".used", week)
     cache.store("dp", "another table", {"values": np.arange(2.0)})
-    assert (folder / stale[3].name).is_dir()
+    assert stale[0].is_dir()
+
+
+def test_a_table_that_cannot_be_deleted_does_not_cost_the_write(folder, monkeypatch):
+    flat = folder / f"dp-{'a' * 24}.npz"
+    flat.write_bytes(b"x")
+    os.utime(flat, (0.0, 0.0))
+    original = Path.unlink
+
+    def refuse(path, *args, **kwargs):
+        if path == flat:
+            raise PermissionError("another user's file")
+        return original(path, *args, **kwargs)
+
+    monkeypatch.setattr(Path, "unlink", refuse)
+    cache.store("dp", "a table beside an undeletable one", {"values": np.arange(2.0)})
+    assert flat.is_file()
+    assert cache.load("dp", "a table beside an undeletable one")["values"].tolist() == [0.0, 1.0]
