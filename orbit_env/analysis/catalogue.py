@@ -317,8 +317,9 @@ def batch_lifetimes(
         record.update(
             perigee_km=format_value(perigee_m[i] / 1e3),
             apogee_km=format_value(apogee_m[i] / 1e3),
-            inclination_deg=format_value(inclination_deg[i]),
-            drag_parameter_m2_kg=format_value(drag_parameter_m2_kg[i]),
+            # A number the row was refused on (or never read, the row refused before it) as the row gave it.
+            inclination_deg=format_value(inclination_deg[i]) or _given_number(row, "inclination_deg"),
+            drag_parameter_m2_kg=format_value(drag_parameter_m2_kg[i]) or _given_number(row, "drag_parameter_m2_kg"),
         )
         if DRAG_SOURCE_KEY in row:  # element sets: where the row's drag came from
             record[DRAG_SOURCE_KEY] = row[DRAG_SOURCE_KEY]
@@ -337,6 +338,15 @@ def batch_lifetimes(
         records.append(record)
     n_ok = sum(1 for s in status if s == "ok")
     return records, BatchSummary(rows=n, ok=n_ok, groups=len(families))
+
+
+def _given_number(row: dict[str, str], key: str) -> str:
+    """A row's cell as it gave it if it is a finite number (a refused value the status names), else empty."""
+    text = row.get(key, "")
+    try:
+        return format_value(float(text))
+    except ValueError:
+        return ""
 
 
 def _from_own_epochs(

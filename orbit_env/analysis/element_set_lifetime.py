@@ -28,11 +28,43 @@ from orbit_env.analysis.elements import ElementSet, parse_tle_text, read_tle
 from orbit_env.analysis.heights import offset_km
 from orbit_env.analysis.lifetime import LifetimeResult, iso_datetime, lifetime
 from orbit_env.analysis.scenario import Scenario
-from orbit_env.decay.solar import unix_days
+from orbit_env.constants import REENTRY_ALTITUDE_M
+from orbit_env.decay.solar import iso_date, unix_days
 from orbit_env.physics.atmosphere.msis import DEFAULT_MSIS_VERSION
+from orbit_env.physics.orbit import MAX_APOGEE_M
 
 #: Element sets give heights above the equatorial radius (WGS84's 6378.137 km).
 REFERENCE = "equatorial"
+
+
+def check_flown(elements: ElementSet, given: str = "the element set") -> None:
+    """An orbit from mean elements that the decay can start from, or an error in the elements' own terms.
+
+    The decay's own check would name a perigee in the 6371 km sphere's heights, which nobody typed.
+
+    Raises:
+        ValueError: the flown perigee below the surface or the re-entry height, or the apogee above the
+            highest the decay follows.
+    """
+    shift = offset_km(REFERENCE)
+    perigee, apogee = elements.flown_perigee_km, elements.flown_apogee_km
+    where = (
+        f"{given} (a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f}) is flown at "
+        f"{perigee:.1f} x {apogee:.1f} km above the equatorial radius"
+    )
+    reentry_km = REENTRY_ALTITUDE_M / 1e3 - shift
+    if not perigee >= 0.0:
+        raise ValueError(f"{where}: its perigee is below the Earth's surface, not an orbit a satellite flies")
+    if not perigee + shift >= REENTRY_ALTITUDE_M / 1e3:
+        raise ValueError(
+            f"{where}: its perigee is below the re-entry height ({REENTRY_ALTITUDE_M / 1e3:g} km above the 6371 km "
+            f"sphere, {reentry_km:.1f} km here), so it is re-entering now; no decay to follow"
+        )
+    if not apogee + shift <= MAX_APOGEE_M / 1e3:
+        raise ValueError(
+            f"{where}: its apogee is above the highest the decay follows ({MAX_APOGEE_M / 1e3:g} km above the "
+            "6371 km sphere)"
+        )
 
 
 @dataclass(frozen=True)
@@ -107,13 +139,16 @@ def element_set_lifetime(
             sets; one object's (one catalogue number).
         satellite: What is known of the satellite (mass and area, c_x, a shape; ``drag_from``:
             what one set's drag is read from). None: the drag from the sets.
-        scenario: The air, dated or not (default: NRLMSIS ``msis_version`` under the shipped
-            record from the latest set's epoch, co-rotating); its heights are the sphere's
-            and are moved to the sets' (`Scenario.in_sphere_heights`).
+        scenario: The air (default: NRLMSIS ``msis_version`` under the shipped record from the
+            latest set's epoch, co-rotating); its heights are the sphere's and are moved to the
+            sets' (`Scenario.in_sphere_heights`). A dated one starts at the latest set's epoch
+            (where its orbit was measured); with the drag from the sets, its scale is 1 (a drag
+            calibrated or fitted to the air absorbs any scale).
         msis_version: NRLMSIS 2.1, 2.0 or 0.0 (NRLMSISE-00) for the default scenario.
 
     Raises:
-        ValueError: no sets, sets of several objects, or what `drag_source` and `lifetime` refuse.
+        ValueError: no sets, sets of several objects, an orbit the decay cannot start from
+            (`check_flown`), a scenario as above, or what `drag_source` and `lifetime` refuse.
     """
     if isinstance(sets, str) and "\n" in sets:
         parsed = parse_tle_text(sets)
@@ -130,14 +165,28 @@ def element_set_lifetime(
             f"element sets of {len(numbers)} objects ({', '.join(numbers)}); one object's sets are its history "
             "(orbit_env.analysis.catalogue reads several objects)"
         )
+    if any(s.epoch_days is None for s in parsed):
+        raise ValueError("an element set without an epoch (mean elements): give its orbit to orbit_env.lifetime")
     history = sorted(parsed, key=lambda s: s.epoch_days)
     latest = history[-1]
+    check_flown(latest)
     inclination = latest.inclination_deg
+    start = unix_days(latest.epoch_iso.rstrip("Z"))  # the epoch as the command line reads the set's (to the second)
     if scenario is None:
         from orbit_env.decay.solar_record import load_record
 
-        # The epoch as the command line reads the set's (to the second).
-        scenario = Scenario(MsisAir(load_record(), unix_days(latest.epoch_iso.rstrip("Z")), version=msis_version))
+        scenario = Scenario(MsisAir(load_record(), start, version=msis_version))
+    elif scenario.epoch_days is not None and abs(scenario.epoch_days - start) > 1.0 / 86400.0:
+        raise ValueError(
+            f"the scenario starts on {iso_date(scenario.epoch_days)}: the decay starts at the element set's epoch "
+            f"({latest.epoch_iso}), where its orbit was measured (Scenario.at_epoch moves a scenario there)"
+        )
+    own = satellite is None or not satellite.given
+    if own and (satellite is None or satellite.drag_from != "bstar-raw") and scenario.density_scale != 1.0:
+        raise ValueError(
+            f"a density scale of {scenario.density_scale:g} changes nothing when the drag is calibrated to the air "
+            "from element sets (the calibration absorbs it); to fly a scale, describe the satellite"
+        )
     air = scenario.in_sphere_heights(REFERENCE, inclination)
     shift = offset_km(REFERENCE)
     sphere = (latest.flown_perigee_km + shift, latest.flown_apogee_km + shift)
@@ -148,6 +197,7 @@ def element_set_lifetime(
         sphere_heights_km=sphere,
         elements=latest,
         history=history if len(history) > 1 else None,
+        ascending_node_local_time_h=getattr(scenario.air, "ascending_node_local_time_h", None),
     )
     result = lifetime(*sphere, satellite=drag.satellite, scenario=air, inclination_deg=inclination)
     return ElementSetLifetime(result, latest, drag, len(history))

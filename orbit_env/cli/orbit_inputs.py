@@ -33,8 +33,7 @@ from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
 from orbit_env.analysis.lifetime import Satellite
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.cli.common import number
-from orbit_env.constants import DAYS_PER_YEAR, REENTRY_ALTITUDE_M
-from orbit_env.physics.orbit import MAX_APOGEE_M
+from orbit_env.constants import DAYS_PER_YEAR
 
 if TYPE_CHECKING:
     from orbit_env.analysis.catalogue_io import BatchOrbits
@@ -179,7 +178,9 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
             raise ValueError("element sets give heights above the equatorial radius; drop --height-reference sphere")
         # Mean elements are not the orbit flown: the decay starts from the flown heights (J2's offset).
         orbit = OrbitInput(elements.flown_perigee_km, elements.flown_apogee_km, reference, elements)
-        _check_flown(orbit, "the element set" if tle is not None else "--semi-major-axis-km/--eccentricity")
+        from orbit_env.analysis.element_set_lifetime import check_flown
+
+        check_flown(elements, "the element set" if tle is not None else "--semi-major-axis-km/--eccentricity")
         return orbit
     return OrbitInput(perigee, apogee, reference)
 
@@ -208,32 +209,6 @@ def _check_element_set_options(args: argparse.Namespace, from_sets: bool, latest
         raise ValueError(
             f"--epoch {args.epoch}: the decay starts at the element set's epoch ({latest.epoch_iso}), where its orbit "
             "was measured; drop --epoch (to fly that orbit from another date, give its heights with --perigee/--apogee)"
-        )
-
-
-def _check_flown(orbit: OrbitInput, given: str) -> None:
-    """An orbit from mean elements that the decay can start from, or an error in the elements' own terms.
-
-    The decay's own check names ``--perigee`` in the 6371 km sphere's heights, which the user never typed.
-    """
-    elements = orbit.elements
-    hp, ha = orbit.sphere_heights_km
-    where = (
-        f"{given} (a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f}) is flown at "
-        f"{orbit.perigee_km:.1f} x {orbit.apogee_km:.1f} km above the equatorial radius"
-    )
-    reentry_km = REENTRY_ALTITUDE_M / 1e3 - orbit.offset_km
-    if not orbit.perigee_km >= 0.0:
-        raise ValueError(f"{where}: its perigee is below the Earth's surface, not an orbit a satellite flies")
-    if not hp >= REENTRY_ALTITUDE_M / 1e3:
-        raise ValueError(
-            f"{where}: its perigee is below the re-entry height ({REENTRY_ALTITUDE_M / 1e3:g} km above the 6371 km "
-            f"sphere, {reentry_km:.1f} km here), so it is re-entering now; no decay to follow"
-        )
-    if not ha <= MAX_APOGEE_M / 1e3:
-        raise ValueError(
-            f"{where}: its apogee is above the highest the decay follows ({MAX_APOGEE_M / 1e3:g} km above the "
-            "6371 km sphere)"
         )
 
 

@@ -174,6 +174,14 @@ def test_batch_rows_with_bad_numbers_name_the_column_and_the_cell(capsys, tmp_pa
         "line 6: perigee_km=90 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)",
         "ok",
     ]
+    # A refused row's inclination and drag parameter are echoed as the row gave them (they had been blank).
+    assert [record["inclination_deg"] for record in csv.DictReader(open(out))][2] == "200"
+    bad_drag = tmp_path / "drag.csv"
+    bad_drag.write_text("perigee_km,apogee_km,drag_parameter_m2_kg,inclination_deg\n400,420,-1,51.6\n")
+    run(capsys, "lifetime", "--batch", str(bad_drag), "--out", str(tmp_path / "drag_out.csv"), "--no-progress")
+    (record,) = csv.DictReader(open(tmp_path / "drag_out.csv"))
+    assert (record["drag_parameter_m2_kg"], record["inclination_deg"]) == ("-1", "51.6")
+    assert record["status"].startswith("line 2: drag_parameter_m2_kg=-1 is out of range")
 
 
 def test_batch_rule_columns(capsys, tmp_path):

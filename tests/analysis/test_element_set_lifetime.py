@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from orbit_env.analysis.drag_source import SatelliteInputs
-from orbit_env.analysis.element_set_lifetime import element_set_lifetime
+from orbit_env.analysis.element_set_lifetime import check_flown, element_set_lifetime
 from orbit_env.cli import main
 
 SETS = Path(__file__).parents[2] / "benchmarks" / "data" / "reentry_tles"
@@ -55,3 +55,40 @@ def test_sets_of_two_objects_or_none_are_refused():
         element_set_lifetime(lines)
     with pytest.raises(ValueError, match="no element sets given"):
         element_set_lifetime([])
+
+
+def test_what_the_command_refuses_the_call_refuses_in_the_same_terms():
+    from orbit_env.analysis.air import MsisAir
+    from orbit_env.analysis.elements import mean_elements
+    from orbit_env.analysis.scenario import Scenario
+    from orbit_env.decay.solar import unix_days
+    from orbit_env.decay.solar_record import load_record
+
+    later = Scenario(MsisAir(load_record(), unix_days("2014-01-01")))
+    with pytest.raises(ValueError, match=r"the scenario starts on 2014-01-01: the decay starts at the element set's"):
+        element_set_lifetime(ONE_SET, scenario=later)
+    own = element_set_lifetime(ONE_SET)
+    scaled = Scenario(MsisAir(load_record(), own.result.epoch_days), density_scale=2.0)
+    with pytest.raises(ValueError, match="a density scale of 2 changes nothing when the drag is calibrated"):
+        element_set_lifetime(ONE_SET, scenario=scaled)
+    with pytest.raises(ValueError, match="without an epoch"):
+        element_set_lifetime([mean_elements(6800.0, 0.001, 51.6)])
+    low = mean_elements(6440.0, 0.001, 51.6)  # flown below the re-entry height
+    with pytest.raises(ValueError, match=r"the element set \(a = 6440.000 km, e = 0.0010000\) is flown .* re-ent"):
+        check_flown(low)
+
+
+def test_a_shape_in_a_sun_synchronous_air_is_the_command_line(capsys):
+    """The node's local time reaches the shape's drag coefficient (the gas at the perigee's local times)."""
+    from orbit_env.analysis.air import MsisAir
+    from orbit_env.analysis.scenario import Scenario
+    from orbit_env.decay.solar import unix_days
+    from orbit_env.decay.solar_record import load_record
+
+    own = element_set_lifetime(ONE_SET)
+    epoch = own.elements.epoch_iso.rstrip("Z")
+    air = Scenario(MsisAir(load_record(), unix_days(epoch), ascending_node_local_time_h=10.0))
+    satellite = SatelliteInputs(mass_kg=4.0, shape="sphere", diameter_m=0.3)
+    found = element_set_lifetime(ONE_SET, satellite, scenario=air)
+    flags = ("--mass", "4", "--shape", "sphere", "--diameter-m", "0.3", "--node-local-time", "10")
+    assert found.to_dict() == _cli(capsys, "--tle", str(ONE_SET), *flags)
