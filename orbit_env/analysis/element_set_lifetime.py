@@ -23,11 +23,12 @@ from pathlib import Path
 from typing import Any
 
 from orbit_env.analysis.air import MsisAir
-from orbit_env.analysis.drag_source import DragSource, SatelliteInputs, drag_source
+from orbit_env.analysis.drag_source import DragSource, SatelliteInputs, drag_sigma, drag_source
 from orbit_env.analysis.elements import ElementSet, parse_tle_text, read_tle
 from orbit_env.analysis.heights import offset_km
 from orbit_env.analysis.lifetime import LifetimeResult, iso_datetime, lifetime
 from orbit_env.analysis.scenario import Scenario
+from orbit_env.analysis.uncertainty import LifetimeSpread, lifetime_spread
 from orbit_env.constants import REENTRY_ALTITUDE_M
 from orbit_env.decay.solar import iso_date, unix_days
 from orbit_env.physics.atmosphere.msis import DEFAULT_MSIS_VERSION
@@ -76,12 +77,34 @@ class ElementSetLifetime:
         elements: The latest set: the start.
         drag: The satellite flown, ``drag_parameter_source`` and its report (the calibration, the fit).
         history: How many sets the object's history holds (1: one set).
+        air: The scenario the decay flew, in the 6371 km sphere's heights.
     """
 
     result: LifetimeResult
     elements: ElementSet
     drag: DragSource
     history: int
+    air: Scenario
+
+    def spread(self, samples: int = 1000, seed: int = 0, workers: int = 1) -> LifetimeSpread:
+        """The lifetime's uncertainty, as ``--uncertainty`` samples it (`orbit_env.analysis.uncertainty`).
+
+        The drag parameter's spread by its source (one set's calibration: wide; a history: its fit's;
+        a described satellite: its drag coefficient's), the density model's and, dated, the Sun's.
+        ``spread_report(spread, result.epoch_days, rule_years)`` gives the command's JSON keys.
+        """
+        sigma = drag_sigma(self.drag)
+        return lifetime_spread(
+            self.result.perigee_km * 1e3,
+            self.result.apogee_km * 1e3,
+            self.drag.satellite.drag_parameter_m2_kg,
+            self.air,
+            self.elements.inclination_deg,
+            samples=samples,
+            seed=seed,
+            workers=workers,
+            **({} if sigma is None else {"drag_sigma": sigma}),
+        )
 
     @property
     def perigee_km(self) -> float:
@@ -200,4 +223,4 @@ def element_set_lifetime(
         ascending_node_local_time_h=getattr(scenario.air, "ascending_node_local_time_h", None),
     )
     result = lifetime(*sphere, satellite=drag.satellite, scenario=air, inclination_deg=inclination)
-    return ElementSetLifetime(result, latest, drag, len(history))
+    return ElementSetLifetime(result, latest, drag, len(history), air)

@@ -92,3 +92,13 @@ def test_a_shape_in_a_sun_synchronous_air_is_the_command_line(capsys):
     found = element_set_lifetime(ONE_SET, satellite, scenario=air)
     flags = ("--mass", "4", "--shape", "sphere", "--diameter-m", "0.3", "--node-local-time", "10")
     assert found.to_dict() == _cli(capsys, "--tle", str(ONE_SET), *flags)
+
+
+def test_the_band_is_the_commands(capsys):
+    """``spread`` samples what ``--uncertainty`` samples: the same percentiles (one set's wide drag spread)."""
+    from orbit_env.analysis.uncertainty import spread_report
+
+    found = element_set_lifetime(ONE_SET)
+    report = spread_report(found.spread(samples=40, seed=3, workers=2), found.result.epoch_days, None)
+    cli = _cli(capsys, "--tle", str(ONE_SET), "--uncertainty", "--samples", "40", "--seed", "3")
+    assert report == {key: cli[key] for key in report}  # the percentiles, dates, samples, seed and sigmas
