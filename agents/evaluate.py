@@ -92,8 +92,14 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     returned = policy.predict(observations, deterministic=True)
     if not (isinstance(returned, tuple) and len(returned) == 2):
         raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
-    if np.asarray(returned[0]).dtype == np.bool_:
+    kind = np.asarray(returned[0]).dtype.kind
+    if kind == "b":
         raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
+    if isinstance(space, gymnasium.spaces.Discrete) and kind == "f":
+        raise ValueError(
+            f"{name}.predict returned floats as actions of a discrete space; allowed: integers (the environment "
+            "refuses a float action)"
+        )
     try:
         actions = np.asarray(returned[0], dtype=np.float64)
     except (TypeError, ValueError):

@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 from orbit_env.agents import VALIDATION_SEED
 from orbit_env.agents.evaluate import Episodes, predicted_actions
 from orbit_env.agents.protocol import Predicts
+from orbit_env.checks import check_int
 from orbit_env.constants import REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_ENV_ID, SOLAR_EVAL_SPLIT, solar_task
 from orbit_env.envs import task as task_model
@@ -54,11 +55,13 @@ LIFE_SHARES = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 3.0)
 GREEDY_BISECTIONS = 20
 
 
-def _largest(task: SolarTask) -> int:
+def largest_burn(task: SolarTask) -> int:
+    """The action of the task's largest burn size (what the threshold rules burn)."""
     return len(task.config.burn_sizes_m_s) - 1
 
 
-def _column(obs: FloatArray, name: str) -> FloatArray:
+def observed(obs: FloatArray, name: str) -> FloatArray:
+    """One component of a batch of observations (n, 11) by its name (`orbit_env.envs.solar_task.SOLAR_OBS_NAMES`)."""
     return np.asarray(obs, dtype=np.float64)[:, SOLAR_OBS_INDEX[name]]
 
 
@@ -99,7 +102,7 @@ class AllAtOnce(Never):
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn size for every observation."""
-        return np.full(len(obs), _largest(self.task), dtype=np.int64)
+        return np.full(len(obs), largest_burn(self.task), dtype=np.int64)
 
 
 class Threshold(Never):
@@ -116,7 +119,7 @@ class Threshold(Never):
 
     def _spare(self, obs: FloatArray) -> NDArray[np.bool_]:
         """Where the tank holds more than the reserve."""
-        return _column(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
+        return observed(obs, "delta_v_left") * DV_SCALE_M_S > self.reserve_m_s + 1e-6
 
 
 class PerigeeThreshold(Threshold):
@@ -127,8 +130,8 @@ class PerigeeThreshold(Threshold):
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn where the perigee is low and the tank holds more than the reserve."""
-        low = _column(obs, "perigee") * HEIGHT_SCALE_M < self.threshold * 1e3
-        return np.where(low & self._spare(obs), _largest(self.task), 0).astype(np.int64)
+        low = observed(obs, "perigee") * HEIGHT_SCALE_M < self.threshold * 1e3
+        return np.where(low & self._spare(obs), largest_burn(self.task), 0).astype(np.int64)
 
 
 class LifeThreshold(Threshold):
@@ -139,10 +142,10 @@ class LifeThreshold(Threshold):
 
     def actions(self, obs: FloatArray) -> NDArray[np.int64]:
         """The largest burn where the predicted life is short of the time left and the tank holds the reserve."""
-        life_days = solar_task.predicted_life_days(_column(obs, "predicted_lifetime"))
-        left_days = (1.0 - _column(obs, "mission_clock")) * self.task.mission_days
+        life_days = solar_task.predicted_life_days(observed(obs, "predicted_lifetime"))
+        left_days = (1.0 - observed(obs, "mission_clock")) * self.task.mission_days
         short = life_days < self.threshold * left_days
-        return np.where(short & self._spare(obs) & (left_days > 0.0), _largest(self.task), 0).astype(np.int64)
+        return np.where(short & self._spare(obs) & (left_days > 0.0), largest_burn(self.task), 0).astype(np.int64)
 
 
 class GreedyConstant(Never):
@@ -265,14 +268,17 @@ def checked_burns(task: SolarTask, burns_m_s: Any, n: int) -> FloatArray:
     Raises:
         ValueError: a burn that is not a number, negative, NaN, above the largest, or (discrete) not a size.
     """
-    burns = np.broadcast_to(np.asarray(burns_m_s, dtype=np.float64), (n,))
+    asked = np.asarray(burns_m_s, dtype=np.float64)
+    if asked.shape not in ((), (n,)):
+        raise ValueError(f"burns of shape {asked.shape} asked for {n} missions flying; allowed: one, or one a mission")
+    burns = np.broadcast_to(asked, (n,))
     top = task.config.max_burn_m_s
     bad = ~np.isfinite(burns) | (burns < 0.0) | (burns > top)
     if not task.continuous:
         bad |= ~np.isin(burns, np.asarray(task.config.burn_sizes_m_s, dtype=np.float64))
     if bad.any():
         allowed = f"0 to {top:g} m/s" if task.continuous else f"the burn sizes {task.config.burn_sizes_m_s} m/s"
-        raise ValueError(f"a burn of {burns[bad][0]:g} m/s asked for; allowed: {allowed}")
+        raise ValueError(f"a burn of {float(burns[bad][0])!r} m/s asked for; allowed: {allowed}")
     return burns
 
 
@@ -319,8 +325,24 @@ def tune(task: SolarTask) -> dict[str, tuple[float, float]]:
     Each candidate flies the same `TUNE_EPISODES` missions of the train split (seed `TUNE_SEED`),
     whatever split ``task`` is on; the rules burn their sizes, so the continuous twin's are the same.
     """
-    rules = tuple(rule for rule in SOLAR_RULES if issubclass(rule, Threshold))
+    rules = tuple(rule for rule in registered_rules() if issubclass(rule, Threshold))
     return _tune(task.config, _with_split(task.mission, "train"), rules)
+
+
+def registered_rules() -> tuple[type[Never], ...]:
+    """`SOLAR_RULES`, checked: each rule its own ``name``, each `Threshold` rule a ``grid`` to tune.
+
+    Raises:
+        ValueError: two rules of one name (a subclass inherits its parent's), or a threshold rule without a grid.
+    """
+    names = [rule.name for rule in SOLAR_RULES]
+    for rule in SOLAR_RULES:
+        if names.count(rule.name) > 1:
+            classes = ", ".join(other.__name__ for other in SOLAR_RULES if other.name == rule.name)
+            raise ValueError(f"rules {classes} share the name {rule.name!r}: give each rule in SOLAR_RULES a name")
+        if issubclass(rule, Threshold) and not rule.grid:
+            raise ValueError(f"{rule.__name__} is a Threshold rule without a grid: give it the thresholds to tune")
+    return SOLAR_RULES
 
 
 @lru_cache(maxsize=4)
@@ -345,7 +367,7 @@ def _with_split(mission: SolarMission, split: str) -> SolarMission:
 def hand_coded(task: SolarTask) -> dict[str, Never]:
     """The operators' rules by name, in `SOLAR_RULES`' order, the thresholds tuned on the train split (`tune`)."""
     tuned = tune(task)
-    return {rule.name: _made(rule, task, tuned) for rule in SOLAR_RULES}
+    return {rule.name: _made(rule, task, tuned) for rule in registered_rules()}
 
 
 def _made(rule: type[Never], task: SolarTask, tuned: Mapping[str, tuple[float, float]]) -> Never:
@@ -433,8 +455,13 @@ def evaluate_solar(
     ``continuous``: the continuous twin (``OrbitRaisingSolarContinuous-v0``): the learned agents act in
     its Box, the DP on a finer grid of burns (`orbit_env.agents.solar_dp.dp_task`); the rules are the same.
     """
+    check_int(episodes, "episodes", low=1)
     mission = SolarMission(solar_split=solar_split, disposal_years=disposal_years)
     task = SolarTask(mission=mission, continuous=continuous)
+    names = {rule.name for rule in registered_rules()} | {"dp"}
+    clash = sorted(names & set(learned or {}))
+    if clash:
+        raise ValueError(f"learned agent {clash[0]!r} has the name of a row of the evaluation; allowed: another name")
     options = starts(task, episodes, seed)
     say = progress or (lambda _: None)
     say("tuning the thresholds on the train split")

@@ -294,7 +294,8 @@ def add_parsers(sub: Any) -> None:
     ev.add_argument(
         "--model",
         metavar="ZIP",
-        help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment)",
+        help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment); "
+        "a policy of your own in Python: docs/how-to/score-a-policy.md",
     )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
     ev.add_argument(

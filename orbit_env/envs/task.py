@@ -212,7 +212,7 @@ class Task:
                 raise ValueError(f"action {a[bad][0].item()!r} is invalid; allowed: integers in [0, {sizes.size - 1}]")
             return sizes.take(a)
         if a.shape not in ((n, 1), (n,)):
-            raise ValueError(f"actions of shape {a.shape} are invalid; allowed: shape ({n}, 1)")
+            raise ValueError(f"actions of shape {a.shape} are invalid; allowed: shape ({n}, 1) or ({n},)")
         a = a.reshape(n).astype(np.float64)
         if np.isnan(a).any():
             raise ValueError("action nan is invalid; allowed: numbers, not NaN (clipped to [-1, 1])")
@@ -693,8 +693,10 @@ def observation_batch(observation: Any, width: int = len(OBS_NAMES)) -> FloatArr
         ValueError: another shape, or a value that is not finite.
     """
     obs = np.asarray(observation, dtype=np.float64)
-    if obs.ndim not in (1, 2) or obs.shape[-1:] != (width,) or not np.all(np.isfinite(obs)):
-        raise ValueError(f"observation must be finite with shape ({width},) or (n, {width}), got shape {obs.shape}")
+    if obs.ndim not in (1, 2) or obs.shape[-1:] != (width,):
+        raise ValueError(f"observation must have shape ({width},) or (n, {width}), got shape {obs.shape}")
+    if not np.all(np.isfinite(obs)):
+        raise ValueError(f"observation must be finite, got {obs[~np.isfinite(obs)][0]} in it")
     return np.atleast_2d(obs)
 
 

@@ -37,7 +37,7 @@ def test_the_solar_certificate_refuses_a_policy_it_would_not_certify():
 def test_fly_refuses_burns_the_environment_would_not_fly(continuous, burn, allowed):
     task = SolarTask(mission=SolarMission(solar_split="test"), continuous=continuous)
     options = starts(task, 2, 12345)
-    with pytest.raises(ValueError, match=f"a burn of {burn:g} m/s asked for; allowed: {allowed}"):
+    with pytest.raises(ValueError, match=f"a burn of {float(burn)!r} m/s asked for; allowed: {allowed}"):
         fly(task, options, lambda states: np.where(states.steps == 0, burn, 0.0))
     # The twin flies any burn in its range (7.5 m/s is no size of the discrete task).
     if continuous:

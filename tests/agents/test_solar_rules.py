@@ -98,3 +98,47 @@ def test_a_tuned_rule_added_to_the_registry_is_tuned(monkeypatch):
     task = SolarTask(mission=SolarMission(solar_split="test"))
     assert solar.tune(task) == {"apogee_threshold": (500.0, 0.0)}  # every reserve ties: the first one kept
     assert isinstance(solar.hand_coded(task)["apogee_threshold"], Apogee)
+
+
+def test_a_rule_without_its_own_name_or_grid_and_a_learned_agent_named_as_a_row_are_refused(monkeypatch):
+    """A subclass inherits its parent's name: it had silently replaced the `never` row capture is measured from."""
+
+    class Forgot(solar.Threshold):
+        grid = (400.0,)
+
+    monkeypatch.setattr(solar, "SOLAR_RULES", (*solar.SOLAR_RULES, Forgot))
+    with pytest.raises(ValueError, match="rules Never, Forgot share the name 'never'"):
+        solar.evaluate_solar(2, 11, include_dp=False)
+
+    class NoGrid(solar.Threshold):
+        name = "no_grid"
+
+    monkeypatch.setattr(solar, "SOLAR_RULES", (solar.Never, NoGrid))
+    with pytest.raises(ValueError, match="NoGrid is a Threshold rule without a grid"):
+        solar.registered_rules()
+    monkeypatch.undo()
+    monkeypatch.setattr(solar, "tune", lambda task: SETTINGS)
+    task = SolarTask(mission=SolarMission(solar_split="test"))
+    for row in ("never", "dp"):
+        with pytest.raises(ValueError, match=f"learned agent '{row}' has the name of a row"):
+            solar.evaluate_solar(2, 11, include_dp=False, learned={row: solar.AllAtOnce(task)})
+    with pytest.raises(ValueError, match="episodes=0 is out of range"):
+        solar.evaluate_solar(0, 11, include_dp=False)
+
+
+def test_float_actions_of_a_discrete_space_are_refused_as_the_environment_refuses_them():
+    from orbit_env.agents.evaluate import predicted_actions
+
+    task = SolarTask(mission=SolarMission(solar_split="test"))
+    obs = solar_task.observe(task, solar_task.start(task, np.random.default_rng(3), 2))
+
+    class Floats:
+        def predict(self, observation, state=None, episode_start=None, deterministic=True):
+            return np.full(len(observation), 3.0), state
+
+    with pytest.raises(ValueError, match=r"Floats\.predict returned floats as actions of a discrete space"):
+        predicted_actions(Floats(), obs, task.action_space)
+    env = gymnasium.make(SOLAR_ENV_ID, solar_split="test")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"action=3\.0 is invalid"):
+        env.step(3.0)
