@@ -20,8 +20,9 @@ hardly shrinks with the subset. CartPole has no counterpart of that, so the
 random-action ratio is the one that matters for training.
 
 The solar task (``OrbitRaisingSolar-v0`` and its continuous twin, issue 28: the same targets) is timed last, on
-fewer steps (``--solar-steps``, ``--solar-vector-steps``; its step is costlier), each run
-in turn with CartPole's on as many steps.
+fewer steps (``--solar-steps``; its step is costlier), each run in turn with CartPole's on as many steps;
+the vector env on a mission's steps (``--solar-vector-steps``), in which every env ends its mission and
+restarts once.
 
 Run: ``python benchmarks/bench_env.py [--steps N] [--vector-steps N] [--repeats R] [--warmup W]``.
 """
@@ -103,7 +104,12 @@ def main() -> None:
         "satellites (full tanks) burn every step, the state training runs in",
     )
     parser.add_argument("--solar-steps", type=int, default=3000, help="single solar-env steps per run")
-    parser.add_argument("--solar-vector-steps", type=int, default=20, help="solar vector-env steps per run")
+    parser.add_argument(
+        "--solar-vector-steps",
+        type=int,
+        default=None,
+        help="solar vector-env steps per run (default: a mission's, every mission's end and restart once)",
+    )
     args = parser.parse_args()
     register_envs()
     rng = np.random.default_rng(0)
@@ -158,7 +164,7 @@ def solar(args: argparse.Namespace, rng: np.random.Generator) -> None:
 
 def solar_one(env_id: str, args: argparse.Namespace, rng: np.random.Generator) -> None:
     """One solar id against CartPole: single env, then vector env at `NUM_ENVS`."""
-    n, m = args.solar_steps, args.solar_vector_steps
+    n = args.solar_steps
     cartpole = gym.make("CartPole-v1")
     cart_actions = rng.integers(0, 2, n).tolist()
     env = gym.make(env_id)
@@ -172,11 +178,14 @@ def solar_one(env_id: str, args: argparse.Namespace, rng: np.random.Generator) -
     print(f"  {env_id:<45} {n / t_env:>12,.0f} steps/s  ratio {t_cart / t_env:.4f}")
     cart_vec = CartPoleVectorEnv(num_envs=NUM_ENVS)
     vec = gym.make_vec(env_id, num_envs=NUM_ENVS)
+    horizon = vec.unwrapped.task.config.horizon_steps
+    m = horizon if args.solar_vector_steps is None else args.solar_vector_steps
     cart_vec_actions = [rng.integers(0, 2, NUM_ENVS) for _ in range(m)]
     vec_actions = [draw_actions(vec.single_action_space, rng, (NUM_ENVS,)) for _ in range(m)]
-    # The batch's missions start together and end together after 61 steps: the timed steps straddle that
-    # end (every mission's rule judged in one step), so the mean step is the steady state's or worse.
-    warmup = max(vec.unwrapped.task.config.horizon_steps - m // 2, 0)
+    # The batch's missions start together and end together after `horizon` steps. Timed from the second
+    # step for a mission's steps, each env ends its mission (its rule judged) and restarts once: the mean
+    # step is the steady state's, as in training, where the missions' ends spread over the steps.
+    warmup = 1
     t_cart, t_env = best_of(
         args.repeats,
         lambda: time_vector(cart_vec, cart_vec_actions, warmup),
