@@ -42,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
-from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, task_of
+from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, predicted_actions, task_of
 from orbit_env.envs import SOLAR_ENV_IDS, SOLAR_EVAL_SPLIT
 
 FloatArray = NDArray[np.float64]
@@ -148,7 +148,7 @@ class _Plans:
                 # then reads one stage of its values a step, see orbit_env.agents.stage_values).
                 action = self.actions(np.zeros(k))
                 rows = np.flatnonzero(running)
-                action[rows] = policy.predict(obs[rows], deterministic=True)[0]
+                action[rows] = predicted_actions(policy, obs[rows], env.single_action_space)  # checked as evaluate's
             obs, reward, terminated, truncated, info = env.step(action)
             returns += np.where(running, reward, 0.0)
             made[:, t] = np.where(running, info["burn_m_s"], 0.0)

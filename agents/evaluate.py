@@ -83,9 +83,10 @@ def check_env_id(env_id: str) -> None:
 def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any]:
     """``policy.predict``'s deterministic actions for a batch of observations, checked against ``space``.
 
-    ``space`` is one environment's action space. A discrete action must be a whole number of its range and a
-    Box action finite, one row per observation: an action the environment itself would refuse is an error
-    naming the policy, not an action quietly rounded or wrapped (2.7 was the 30 m/s burn, -1 the largest).
+    ``space`` is one environment's action space. A discrete action must be an integer of its range (the
+    environment refuses floats, 2.0 too) and a Box action finite, one row per observation: an action the
+    environment itself would refuse is an error naming the policy, not an action quietly rounded or wrapped
+    (2.7 was the 30 m/s burn, -1 the largest).
     """
     name = type(policy).__name__
     rows = len(observations)
@@ -95,11 +96,6 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     kind = np.asarray(returned[0]).dtype.kind
     if kind == "b":
         raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
-    if isinstance(space, gymnasium.spaces.Discrete) and kind == "f":
-        raise ValueError(
-            f"{name}.predict returned floats as actions of a discrete space; allowed: integers (the environment "
-            "refuses a float action)"
-        )
     try:
         actions = np.asarray(returned[0], dtype=np.float64)
     except (TypeError, ValueError):
@@ -110,10 +106,15 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     if not np.all(np.isfinite(actions)):
         raise ValueError(f"{name}.predict returned an action that is not finite: {actions[~np.isfinite(actions)][0]}")
     if isinstance(space, gymnasium.spaces.Discrete):
-        whole = (actions == np.round(actions)) & (actions >= space.start) & (actions < space.start + space.n)
-        if not whole.all():
-            allowed = f"whole numbers in [{space.start}, {space.start + space.n - 1}]"
-            raise ValueError(f"{name}.predict returned action {actions[~whole][0]:g}; allowed: {allowed}")
+        allowed = f"integers in [{space.start}, {space.start + space.n - 1}]"
+        if kind not in "iu":
+            raise ValueError(
+                f"{name}.predict returned floats as actions of a discrete space ({actions[0]:g} first); allowed: "
+                f"{allowed} (the environment refuses a float action, 2.0 too)"
+            )
+        inside = (actions >= space.start) & (actions < space.start + space.n)
+        if not inside.all():
+            raise ValueError(f"{name}.predict returned action {actions[~inside][0]:g}; allowed: {allowed}")
         return actions.astype(np.int64)
     return actions.astype(space.dtype)
 

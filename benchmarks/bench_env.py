@@ -21,8 +21,8 @@ random-action ratio is the one that matters for training.
 
 The solar task (``OrbitRaisingSolar-v0`` and its continuous twin, issue 28: the same targets) is timed last, on
 fewer steps (``--solar-steps``; its step is costlier), each run in turn with CartPole's on as many steps;
-the vector env on a mission's steps (``--solar-vector-steps``), in which every env ends its mission and
-restarts once.
+the vector env on a mission's steps and its restart (``--solar-vector-steps``), in which (nearly) every
+env ends its mission and restarts once.
 
 Run: ``python benchmarks/bench_env.py [--steps N] [--vector-steps N] [--repeats R] [--warmup W]``.
 """
@@ -108,7 +108,7 @@ def main() -> None:
         "--solar-vector-steps",
         type=int,
         default=None,
-        help="solar vector-env steps per run (default: a mission's, every mission's end and restart once)",
+        help="solar vector-env steps per run (default: a mission's and its restart, a cycle of every env)",
     )
     args = parser.parse_args()
     register_envs()
@@ -179,11 +179,12 @@ def solar_one(env_id: str, args: argparse.Namespace, rng: np.random.Generator) -
     cart_vec = CartPoleVectorEnv(num_envs=NUM_ENVS)
     vec = gym.make_vec(env_id, num_envs=NUM_ENVS)
     horizon = vec.unwrapped.task.config.horizon_steps
-    m = horizon if args.solar_vector_steps is None else args.solar_vector_steps
+    m = horizon + 1 if args.solar_vector_steps is None else args.solar_vector_steps
     cart_vec_actions = [rng.integers(0, 2, NUM_ENVS) for _ in range(m)]
     vec_actions = [draw_actions(vec.single_action_space, rng, (NUM_ENVS,)) for _ in range(m)]
-    # The batch's missions start together and end together after `horizon` steps. Timed from the second
-    # step for a mission's steps, each env ends its mission (its rule judged) and restarts once: the mean
+    # The batch's missions start together and end together after `horizon` steps; under NEXT_STEP the step
+    # after restarts them: a cycle of horizon + 1 steps. Timed over one cycle from the second step, (nearly:
+    # an early re-entry ends twice) every env ends its mission, its rule judged, and restarts once: the mean
     # step is the steady state's, as in training, where the missions' ends spread over the steps.
     warmup = 1
     t_cart, t_env = best_of(

@@ -18,9 +18,11 @@ Examples:
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.drag_source import DragSource, SatelliteInputs, drag_sigma, drag_source
@@ -30,7 +32,7 @@ from orbit_env.analysis.lifetime import LifetimeResult, iso_datetime, lifetime
 from orbit_env.analysis.scenario import Scenario
 from orbit_env.analysis.uncertainty import LifetimeSpread, lifetime_spread
 from orbit_env.constants import REENTRY_ALTITUDE_M
-from orbit_env.decay.solar import iso_date, unix_days
+from orbit_env.decay.solar import unix_days
 from orbit_env.physics.atmosphere.msis import DEFAULT_MSIS_VERSION
 from orbit_env.physics.orbit import MAX_APOGEE_M
 
@@ -84,7 +86,7 @@ class ElementSetLifetime:
     elements: ElementSet
     drag: DragSource
     history: int
-    air: Scenario
+    air: Scenario = field(compare=False, repr=False)
 
     def spread(self, samples: int = 1000, seed: int = 0, workers: int = 1) -> LifetimeSpread:
         """The lifetime's uncertainty, as ``--uncertainty`` samples it (`orbit_env.analysis.uncertainty`).
@@ -201,7 +203,8 @@ def element_set_lifetime(
         scenario = Scenario(MsisAir(load_record(), start, version=msis_version))
     elif scenario.epoch_days is not None and abs(scenario.epoch_days - start) > 1.0 / 86400.0:
         raise ValueError(
-            f"the scenario starts on {iso_date(scenario.epoch_days)}: the decay starts at the element set's epoch "
+            f"the scenario starts at {np.datetime64(round(scenario.epoch_days * 86400.0), 's')}Z: the decay starts "
+            "at the element set's epoch "
             f"({latest.epoch_iso}), where its orbit was measured (Scenario.at_epoch moves a scenario there)"
         )
     own = satellite is None or not satellite.given

@@ -122,13 +122,14 @@ class Returns:
 @pytest.mark.parametrize(
     ("make", "message"),
     [
-        (lambda o: np.full(len(o), 2.7), r"Returns.predict returned action 2.7; allowed: whole numbers in \[0, 3\]"),
-        (lambda o: np.full(len(o), -1), r"returned action -1; allowed: whole numbers in \[0, 3\]"),
+        (lambda o: np.full(len(o), 2.7), r"Returns.predict returned floats as actions .* \(2.7 first\); allowed: int"),
+        (lambda o: np.full(len(o), 2.0), r"returned floats as actions .*\(the environment refuses a float action"),
+        (lambda o: np.full(len(o), -1), r"returned action -1; allowed: integers in \[0, 3\]"),
         (lambda o: np.full(len(o), np.nan), r"returned an action that is not finite: nan"),
         (lambda o: np.zeros((len(o), 1)), r"returned actions of shape \(5, 1\), not \(5,\) \(5 observations\)"),
         (lambda o: ["a"] * len(o), r"returned actions that are not numbers"),
     ],
-    ids=["fraction", "negative", "nan", "shape", "text"],
+    ids=["fraction", "whole float", "negative", "nan", "shape", "text"],
 )
 def test_a_policys_bad_actions_are_refused_naming_it_not_rounded_or_wrapped(make, message):
     # evaluate wrote them into an int64 array: 2.7 flew the 30 m/s burn, and in the solar task -1 the largest.
@@ -138,7 +139,7 @@ def test_a_policys_bad_actions_are_refused_naming_it_not_rounded_or_wrapped(make
         run_episodes("OrbitRaising-v0", Returns(make), episodes=5, seed=0)
     with pytest.raises(ValueError, match=message.replace("(5", "(3").replace("5 obs", "3 obs")):
         fly_model(Returns(make), 3, 0)
-    assert run_episodes("OrbitRaising-v0", Returns(lambda o: np.full(len(o), 2.0)), episodes=5, seed=0).returns.size
+    assert run_episodes("OrbitRaising-v0", Returns(lambda o: np.full(len(o), 2)), episodes=5, seed=0).returns.size
 
 
 def test_the_solar_task_is_sent_to_its_own_evaluation_and_every_id_is_named():

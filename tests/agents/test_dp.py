@@ -231,7 +231,7 @@ def test_invalid_observations_and_states_raise(solution):
     policy = DPPolicy(solution=solution)
     with pytest.raises(ValueError, match="shape"):
         policy.predict(np.zeros(6, dtype=np.float32))
-    with pytest.raises(ValueError, match="shape"):
+    with pytest.raises(ValueError, match="must be finite, got nan"):
         policy.predict(np.full(7, np.nan, dtype=np.float32))
     with pytest.raises(ValueError, match="steps_left"):
         solution.value(300.0, 600.0, 100.0, CONFIG.horizon_steps + 1)
