@@ -123,12 +123,13 @@ def run_in_parts(
     folder = parts_folder(out)
     folder.mkdir(exist_ok=True)
     bounds = [(start, min(start + rows_per_chunk, n_rows)) for start in range(0, n_rows, rows_per_chunk)]
-    done = _found_parts(folder, key, len(bounds), restart)
+    done, deleted = _found_parts(folder, key, len(bounds), restart)
     missing = [k for k in range(len(bounds)) if k not in done]
     processes = max(1, min(workers, len(missing)))
     report(
         f"{n_rows} rows in {len(bounds)} chunks of up to {rows_per_chunk}"
         + (f", {len(done)} already in {folder}" if done else "")
+        + (f" ({deleted} part{'s' if deleted > 1 else ''} of another run deleted)" if deleted else "")
         + (f"; Ray at {address}" if address else f"; {processes} worker{'s' if processes > 1 else ''}")
     )
     rows_done = sum(bounds[k][1] - bounds[k][0] for k in done)
@@ -268,9 +269,13 @@ def _part_path(folder: Path, key: str, chunk: int) -> Path:
     return folder / f"{key}-{chunk:06d}.csv"
 
 
-def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> set[int]:
-    """The chunks whose parts of this fingerprint are in ``folder``; temporary files of a stopped write removed."""
+def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> tuple[set[int], int]:
+    """The chunks whose parts of this fingerprint are in ``folder``, and how many of another run ``restart`` deleted.
+
+    Temporary files of a stopped write are removed.
+    """
     done = set()
+    deleted = 0
     for path in sorted(folder.iterdir()):
         match = _PART.match(path.name)
         if path.name.startswith(".") and path.name.endswith(".tmp"):
@@ -284,9 +289,10 @@ def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> set[int]
                     "finish it, or give --force to delete its parts and start this one"
                 )
             path.unlink()
+            deleted += 1
         else:
             done.add(int(match["chunk"]))
-    return done
+    return done, deleted
 
 
 def _join(out: str | Path, parts: list[Path]) -> JoinedParts:

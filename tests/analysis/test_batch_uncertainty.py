@@ -3,6 +3,7 @@
 import csv
 import json
 import os
+import re
 import sys
 
 import numpy as np
@@ -186,8 +187,9 @@ def test_parts_of_another_command_are_refused_or_replaced(capsys, tmp_path, monk
     monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", call)
     status, _, err, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60)
     assert status == 2 and "holds the parts of another run" in err and not out.exists()
-    status, _, _, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60, "--force")
+    status, stdout, _, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60, "--force")
     assert status == 1 and out.read_bytes() == fresh.read_bytes()
+    assert re.search(r"\(\d+ parts? of another run deleted\)", stdout), stdout  # --force says what it deleted
 
 
 def test_element_sets_are_dated_by_their_epochs(capsys, tmp_path):
