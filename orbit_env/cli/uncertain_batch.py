@@ -85,9 +85,14 @@ def check_options(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace, orbits: BatchOrbits, scenario: Scenario) -> JoinedParts:
     """Compute the bands of every row of ``orbits`` in ``scenario`` (heights above the sphere); write ``args.out``."""
     workers = args.workers
+    lines = []
     if workers is None and args.address is None:
         workers = os.cpu_count() or 1
-        print(f"workers: {workers} (the default: all cores; --workers N to change)")
+        lines.append(f"workers: {workers} (the default: all cores; --workers N to change)")
+
+    def report(line: str) -> None:  # once the parts folder is checked: an error comes alone
+        print(*lines, line, sep="\n")
+
     size = chunk_rows(len(orbits.rows), scenario.time_varying)
     files = [args.batch] + ([args.solar_csv] if getattr(args, "solar_csv", None) else [])
     options = {name: value for name, value in sorted(vars(args).items()) if name not in NOT_IN_FINGERPRINT}
@@ -112,4 +117,5 @@ def run(args: argparse.Namespace, orbits: BatchOrbits, scenario: Scenario) -> Jo
         address=args.address,
         progress=not args.no_progress,
         restart=args.force,
+        report=report,
     )

@@ -185,8 +185,9 @@ def test_parts_of_another_command_are_refused_or_replaced(capsys, tmp_path, monk
     monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", stopped)
     batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 50, "--workers", 1)
     monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", call)
-    status, _, err, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60)
+    status, stdout, err, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60)
     assert status == 2 and "holds the parts of another run" in err and not out.exists()
+    assert "workers:" not in stdout  # the refusal comes alone, not after a line about a run that does not start
     status, stdout, _, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60, "--force")
     assert status == 1 and out.read_bytes() == fresh.read_bytes()
     assert re.search(r"\(\d+ parts? of another run deleted\)", stdout), stdout  # --force says what it deleted
