@@ -6,6 +6,7 @@ This is the public edge, so heights are in km and every input is checked here
 
 from __future__ import annotations
 
+import datetime
 import math
 import warnings
 from dataclasses import asdict, dataclass, field, replace
@@ -240,7 +241,7 @@ def lifetime(
     atmosphere: Atmosphere | None = None,
     rotating_atmosphere: bool | None = None,
     activity: SolarActivity | None = None,
-    epoch: str | float | None = None,
+    epoch: str | float | datetime.date | np.datetime64 | None = None,
     ascending_node_local_time_h: float | None = None,
     chunk_days: float | None = None,
 ) -> LifetimeResult:
@@ -274,7 +275,8 @@ def lifetime(
             otherwise the satellite is stepped through time on the universal curves
             (``method="curves"``, `orbit_env.decay.chunked`) or, as a slow reference, by
             the averaged equations with a fresh profile every day (``method="averaged"``).
-        epoch: Date of the orbit (``YYYY-MM-DD``, or unix days). With NRLMSIS it
+        epoch: Date of the orbit (``YYYY-MM-DD`` or with a time, a ``datetime.date``/``datetime`` or
+            ``numpy.datetime64``, or unix days). With NRLMSIS it
             makes the season count, and places the orbit in time-varying activity.
             None: a table's first date; for other activity day 0 (1970-01-01)
             with the season averaged (use ``CycleActivity.with_phase(phase, 0.0)``).
@@ -420,7 +422,7 @@ def scenario_from_keywords(
     atmosphere: Atmosphere | None = None,
     rotating_atmosphere: bool | None = None,
     activity: SolarActivity | None = None,
-    epoch: str | float | None = None,
+    epoch: str | float | datetime.date | np.datetime64 | None = None,
     ascending_node_local_time_h: float | None = None,
     chunk_days: float = DEFAULT_CHUNK_DAYS,
 ) -> Scenario:
@@ -469,9 +471,13 @@ def check_lifetime_days(days: float) -> float:
     return days
 
 
-def _start_days(activity: SolarActivity, epoch: str | float | None) -> float:
+def _start_days(activity: SolarActivity, epoch: str | float | datetime.date | np.datetime64 | None) -> float:
     if epoch is None:
         return activity.start_days if isinstance(activity, TableActivity) else 0.0
+    if isinstance(epoch, datetime.date):  # a datetime too; its zone, if it has one, read (UTC if not)
+        epoch = epoch.isoformat()
+    elif isinstance(epoch, np.datetime64):
+        epoch = str(epoch)
     if not isinstance(epoch, str):
         return check_date(check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD"), "epoch")
     return check_date(unix_days(epoch), "epoch", text=epoch)

@@ -82,3 +82,17 @@ def test_results_compare_and_hash_by_their_numbers():
     assert result != orbit_env.lifetime(360, 900)
     constant = Scenario(MsisAir(ConstantActivity(150.0, 150.0, 15.0)))
     assert len({result, orbit_env.lifetime(360, 800, scenario=constant)}) == 2
+
+
+def test_an_epoch_may_be_a_date_a_datetime_or_a_numpy_datetime():
+    import datetime
+
+    sat = dict(satellite=CUBESAT, inclination_deg=51.6)
+    text = orbit_env.lifetime(350, 350, epoch="2024-01-01T06:00Z", **sat)
+    utc = datetime.UTC
+    assert orbit_env.lifetime(350, 350, epoch=datetime.datetime(2024, 1, 1, 6, tzinfo=utc), **sat) == text
+    zoned = datetime.datetime(2024, 1, 1, 8, tzinfo=datetime.timezone(datetime.timedelta(hours=2)))
+    assert orbit_env.lifetime(350, 350, epoch=zoned, **sat) == text  # 08:00 at +02:00 is 06:00 UTC
+    assert orbit_env.lifetime(350, 350, epoch=np.datetime64("2024-01-01T06:00"), **sat) == text
+    day = orbit_env.lifetime(350, 350, epoch=datetime.date(2024, 1, 1), **sat)
+    assert day == orbit_env.lifetime(350, 350, epoch="2024-01-01", **sat) != text
