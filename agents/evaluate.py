@@ -105,12 +105,15 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
         raise ValueError(f"{name}.predict returned actions of shape {actions.shape}, not {shape} ({rows} observations)")
     if not np.all(np.isfinite(actions)):
         raise ValueError(f"{name}.predict returned an action that is not finite: {actions[~np.isfinite(actions)][0]}")
+    if actions.size == 0:  # no observation, no action
+        return actions.astype(np.int64 if isinstance(space, gymnasium.spaces.Discrete) else space.dtype)
     if isinstance(space, gymnasium.spaces.Discrete):
         allowed = f"integers in [{space.start}, {space.start + space.n - 1}]"
         if kind not in "iu":
+            dtype = np.asarray(returned[0]).dtype
             raise ValueError(
-                f"{name}.predict returned floats as actions of a discrete space ({actions[0]:g} first); allowed: "
-                f"{allowed} (the environment refuses a float action, 2.0 too)"
+                f"{name}.predict returned {dtype} actions for a discrete space ({float(actions.flat[0])!r} first); "
+                f"allowed: {allowed} (the environment refuses a float action, 2.0 too)"
             )
         inside = (actions >= space.start) & (actions < space.start + space.n)
         if not inside.all():

@@ -93,7 +93,8 @@ class ElementSetLifetime:
 
         The drag parameter's spread by its source (one set's calibration: wide; a history: its fit's;
         a described satellite: its drag coefficient's), the density model's and, dated, the Sun's.
-        ``spread_report(spread, result.epoch_days, rule_years)`` gives the command's JSON keys.
+        ``orbit_env.analysis.uncertainty.spread_report(spread, result.epoch_days, rule_years)`` gives the
+        command's JSON keys.
         """
         sigma = drag_sigma(self.drag)
         return lifetime_spread(

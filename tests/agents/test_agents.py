@@ -122,8 +122,8 @@ class Returns:
 @pytest.mark.parametrize(
     ("make", "message"),
     [
-        (lambda o: np.full(len(o), 2.7), r"Returns.predict returned floats as actions .* \(2.7 first\); allowed: int"),
-        (lambda o: np.full(len(o), 2.0), r"returned floats as actions .*\(the environment refuses a float action"),
+        (lambda o: np.full(len(o), 2.7), r"Returns.predict returned float64 actions .* \(2.7 first\); allowed: int"),
+        (lambda o: np.full(len(o), 2.0), r"returned float64 actions .*\(2.0 first\).*refuses a float action"),
         (lambda o: np.full(len(o), -1), r"returned action -1; allowed: integers in \[0, 3\]"),
         (lambda o: np.full(len(o), np.nan), r"returned an action that is not finite: nan"),
         (lambda o: np.zeros((len(o), 1)), r"returned actions of shape \(5, 1\), not \(5,\) \(5 observations\)"),

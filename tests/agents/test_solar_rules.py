@@ -136,7 +136,7 @@ def test_float_actions_of_a_discrete_space_are_refused_as_the_environment_refuse
         def predict(self, observation, state=None, episode_start=None, deterministic=True):
             return np.full(len(observation), 3.0), state
 
-    with pytest.raises(ValueError, match=r"Floats\.predict returned floats as actions of a discrete space"):
+    with pytest.raises(ValueError, match=r"Floats\.predict returned float64 actions for a discrete space \(3\.0"):
         predicted_actions(Floats(), obs, task.action_space)
     env = gymnasium.make(SOLAR_ENV_ID, solar_split="test")
     env.reset(seed=0)

@@ -96,3 +96,19 @@ def test_an_epoch_may_be_a_date_a_datetime_or_a_numpy_datetime():
     assert orbit_env.lifetime(350, 350, epoch=np.datetime64("2024-01-01T06:00"), **sat) == text
     day = orbit_env.lifetime(350, 350, epoch=datetime.date(2024, 1, 1), **sat)
     assert day == orbit_env.lifetime(350, 350, epoch="2024-01-01", **sat) != text
+
+
+def test_a_numpy_month_is_its_first_day_and_nat_is_no_date():
+    """numpy reads ``datetime64('2024-01')`` as 2024-01-01 (the text '2024-01' is the 15th here); seconds kept."""
+    import datetime
+
+    sat = dict(satellite=CUBESAT, inclination_deg=51.6)
+    month = orbit_env.lifetime(350, 350, epoch=np.datetime64("2024-01"), **sat)
+    assert month.epoch_days == unix_days("2024-01-01")
+    assert month == orbit_env.lifetime(350, 350, epoch="2024-01-01", **sat)
+    half = datetime.datetime(2024, 1, 1, 6, 0, 0, 500000)
+    naive = orbit_env.lifetime(350, 350, epoch=half, **sat)
+    assert naive == orbit_env.lifetime(350, 350, epoch=half.replace(tzinfo=datetime.UTC), **sat)  # naive is UTC
+    assert naive.epoch_days == unix_days("2024-01-01T06:00:00") + 0.5 / 86400.0
+    with pytest.raises(ValueError, match="epoch=NaT is not a date"):
+        orbit_env.lifetime(350, 350, epoch=np.datetime64("NaT"), **sat)
