@@ -90,9 +90,11 @@ class Never(Predicts):
         Raises:
             ValueError: an observation of another shape, or not finite.
         """
-        obs = observation_batch(observation, len(SOLAR_OBS_NAMES))
-        burns = np.asarray(self.task.config.burn_sizes_m_s, dtype=np.float64)[self.actions(obs)]
-        return self.task.encode(burns)
+        return self.task.encode(self.burns_m_s(observation_batch(observation, len(SOLAR_OBS_NAMES))))
+
+    def burns_m_s(self, obs: FloatArray) -> FloatArray:
+        """The burns [m/s] the rule's `actions` (indices of the task's sizes) ask for on observations (n, 11)."""
+        return self.task.burn_sizes_m_s[self.actions(obs)]
 
 
 class AllAtOnce(Never):
@@ -275,7 +277,7 @@ def checked_burns(task: SolarTask, burns_m_s: Any, n: int) -> FloatArray:
     top = task.config.max_burn_m_s
     bad = ~np.isfinite(burns) | (burns < 0.0) | (burns > top)
     if not task.continuous:
-        bad |= ~np.isin(burns, np.asarray(task.config.burn_sizes_m_s, dtype=np.float64))
+        bad |= ~np.isin(burns, task.burn_sizes_m_s)
     if bad.any():
         allowed = f"0 to {top:g} m/s" if task.continuous else f"the burn sizes {task.config.burn_sizes_m_s} m/s"
         raise ValueError(f"a burn of {float(burns[bad][0])!r} m/s asked for; allowed: {allowed}")
@@ -284,8 +286,7 @@ def checked_burns(task: SolarTask, burns_m_s: Any, n: int) -> FloatArray:
 
 def by_observation(task: SolarTask, policy: Never) -> Callable[[BatchState], FloatArray]:
     """An observation policy as `fly`'s ``act``: it sees `orbit_env.envs.solar_task.observe`, no more."""
-    sizes = np.array(task.config.burn_sizes_m_s)
-    return lambda state: sizes[policy.actions(solar_task.observe(task, state))]
+    return lambda state: policy.burns_m_s(solar_task.observe(task, state))
 
 
 def by_model(task: SolarTask, model: Any) -> Callable[[BatchState], FloatArray]:
