@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from orbit_env.analysis.air import Air, MsisAir, PaperAir, ProfileAir
 from orbit_env.analysis.disposal import RuleCheck, check_disposal_rule
-from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density
+from orbit_env.analysis.scenario import DENSITY_SCALE_RANGE, Scenario, check_curves_density, check_scenario
 from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel, integrate_averaged
@@ -308,8 +308,8 @@ def lifetime(
     satellite = Satellite() if satellite is None else satellite
     if not isinstance(satellite, Satellite):
         raise TypeError(f"satellite must be a Satellite (orbit_env.Satellite), got {type(satellite).__name__}")
-    if scenario is not None and not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a Scenario (orbit_env.analysis.scenario), got {type(scenario).__name__}")
+    if scenario is not None:
+        check_scenario(scenario)
     keywords = {
         "rho100_kg_m3": rho100_kg_m3,
         "atmosphere": atmosphere,

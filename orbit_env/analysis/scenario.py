@@ -21,7 +21,7 @@ from orbit_env.decay.curves import UniversalCurves, days_from_weighted_s
 from orbit_env.decay.solar import SolarActivity, iso_date
 from orbit_env.physics.atmosphere import Atmosphere
 from orbit_env.physics.atmosphere.paper import RHO100_CALIBRATED_KG_M3
-from orbit_env.physics.satellite_bounds import DRAG_PARAMETER_RANGE_M2_KG
+from orbit_env.physics.satellite_bounds import check_drag_parameter
 
 FloatArray = NDArray[np.float64]
 #: Bounds of a density scale factor, and why.
@@ -32,6 +32,17 @@ DENSITY_SCALE_RANGE = (1e-3, 1e3, "the models are off by a factor of a few at mo
 #: calibrated law. The curves step through nu on a fixed grid, and in denser air the perigee moves
 #: too far per step near re-entry (at 30 times the family no longer closes, measured at 300 x 3000 km).
 CURVES_MAX_RHO100_KG_M3 = 20.0 * RHO100_CALIBRATED_KG_M3
+
+
+def check_scenario(value: object) -> Scenario:
+    """``value`` if it is a `Scenario` (a parameter ``scenario``'s check).
+
+    Raises:
+        TypeError: anything else (an air model's name, None), named by its type.
+    """
+    if not isinstance(value, Scenario):
+        raise TypeError(f"scenario must be a Scenario (orbit_env.analysis.scenario), got {type(value).__name__}")
+    return value
 
 
 def check_curves_density(atmosphere: Atmosphere) -> None:
@@ -183,8 +194,7 @@ class Scenario:
                 catalogue's one-family path serves those).
         """
         hp, ha = UniversalCurves.check_domain(perigee_m, apogee_m)
-        low, high, why = DRAG_PARAMETER_RANGE_M2_KG
-        c = check_array(drag_parameter_m2_kg, "drag_parameter_m2_kg", unit="m^2/kg", low=low, high=high, why=why)
+        c = check_drag_parameter(drag_parameter_m2_kg)
         s = check_array(density_scale, "density_scale", low=0.0, low_inclusive=False)
         hp, ha, c, s = np.broadcast_arrays(hp, ha, c, s)
         s = s * self.density_scale

@@ -48,11 +48,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from orbit_env.analysis.scenario import Scenario
+from orbit_env.analysis.scenario import check_scenario
 from orbit_env.checks import check_int, check_number
 from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.curves import UniversalCurves
-from orbit_env.physics.satellite_bounds import DRAG_PARAMETER_RANGE_M2_KG
+from orbit_env.physics.satellite_bounds import check_drag_parameter
 
 FloatArray = NDArray[np.float64]
 
@@ -193,11 +193,9 @@ def lifetime_spread(
         ValueError: heights outside the universal curves' domain (metres, not km), a drag parameter
             out of range, or not a `Scenario`.
     """
-    if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a Scenario (orbit_env.analysis.scenario), got {type(scenario).__name__}")
+    check_scenario(scenario)
     UniversalCurves.check_domain(perigee_m, apogee_m)  # the samples decay on the curves, dated or not
-    low, high, why = DRAG_PARAMETER_RANGE_M2_KG
-    check_number(drag_parameter_m2_kg, "drag_parameter_m2_kg", unit="m^2/kg", low=low, high=high, why=why)
+    check_drag_parameter(drag_parameter_m2_kg)
     z_sun, density, drag = sample_factors(samples, seed, drag_sigma)
     scale = density * drag
     drag_key = "drag_coefficient" if drag_sigma == DRAG_COEFFICIENT_SIGMA else "drag_parameter"

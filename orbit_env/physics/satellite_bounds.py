@@ -10,6 +10,11 @@ against these. SI units.
 
 from __future__ import annotations
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from orbit_env.checks import check_array
+
 #: Drag coefficient c_x (dimensionless).
 DRAG_COEFFICIENT_RANGE = (0.0, 10.0, "free-molecular drag coefficients are 2 to 4 for any shape")
 #: Mass [kg].
@@ -24,3 +29,13 @@ MASS_PER_AREA_RANGE_KG_M2 = (
 )
 #: Drag parameter c = c_x F / m [m^2/kg] (Eq. 3.4).
 DRAG_PARAMETER_RANGE_M2_KG = (1e-5, 1e3, "c_x A / m within the bounds of c_x and of mass / area")
+
+
+def check_drag_parameter(values: ArrayLike) -> NDArray[np.float64]:
+    """Drag parameters ``drag_parameter_m2_kg`` (a number or an array) within `DRAG_PARAMETER_RANGE_M2_KG`.
+
+    Raises:
+        ValueError: one that is not a finite number in the range (the message names it).
+    """
+    low, high, why = DRAG_PARAMETER_RANGE_M2_KG
+    return check_array(values, "drag_parameter_m2_kg", unit="m^2/kg", low=low, high=high, why=why)
