@@ -474,28 +474,13 @@ def check_lifetime_days(days: float) -> float:
 def _start_days(activity: SolarActivity, epoch: str | float | datetime.date | np.datetime64 | None) -> float:
     if epoch is None:
         return activity.start_days if isinstance(activity, TableActivity) else 0.0
+    if isinstance(epoch, np.datetime64) and np.isnat(epoch):
+        raise ValueError("epoch=NaT is not a date; allowed: a date from 1957-10-04 to 2200-12-31")
     if isinstance(epoch, (datetime.date, np.datetime64)):
-        return check_date(_unix_days_of(epoch), "epoch", text=str(epoch))
+        return check_date(unix_days(epoch), "epoch", text=str(epoch))
     if not isinstance(epoch, str):
         return check_date(check_number(epoch, "epoch", unit="unix days", why="or a date YYYY-MM-DD"), "epoch")
     return check_date(unix_days(epoch), "epoch", text=epoch)
-
-
-def _unix_days_of(moment: datetime.date | np.datetime64) -> float:
-    """Unix days of a date, a datetime (its zone read; UTC if it has none) or a numpy datetime64 (UTC).
-
-    Raises:
-        ValueError: a datetime64 that is not a time (NaT).
-    """
-    if isinstance(moment, np.datetime64):
-        if np.isnat(moment):
-            raise ValueError("epoch=NaT is not a date; allowed: a date from 1957-10-04 to 2200-12-31")
-        return float((moment - np.datetime64(0, "s")) / np.timedelta64(1, "D"))
-    if not isinstance(moment, datetime.datetime):
-        moment = datetime.datetime(moment.year, moment.month, moment.day)
-    if moment.tzinfo is None or moment.utcoffset() is None:
-        moment = moment.replace(tzinfo=datetime.UTC)
-    return (moment - datetime.datetime(1970, 1, 1, tzinfo=datetime.UTC)) / datetime.timedelta(days=1)
 
 
 def _lifetime_under_activity(

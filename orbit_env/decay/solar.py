@@ -56,11 +56,22 @@ def unix_days(date: str | _dt.date | np.datetime64) -> float:
     """Days since 1970-01-01 of an ISO date (``YYYY-MM-DD``, ``YYYY-MM`` = the 15th, or with a time).
 
     A time may carry its zone (``Z``, ``+02:00``), as element sets' epochs are printed: it is
-    converted to UTC; a time without one is UTC.
+    converted to UTC; a time without one is UTC. A ``datetime.date``, a ``datetime`` (its zone,
+    UTC if none) or a ``numpy.datetime64`` is read as the time it is, to its fractions of a second
+    (numpy's ``datetime64('2024-01')`` is the 1st).
 
     Raises:
-        ValueError: the date cannot be read.
+        ValueError: the date cannot be read (a datetime64 NaT).
     """
+    if isinstance(date, np.datetime64):
+        if np.isnat(date):
+            raise ValueError("NaT is not a date")
+        return float((date - np.datetime64(0, "s")) / np.timedelta64(1, "D"))
+    if isinstance(date, _dt.date):
+        moment = date if isinstance(date, _dt.datetime) else _dt.datetime(date.year, date.month, date.day)
+        if moment.tzinfo is None or moment.utcoffset() is None:
+            moment = moment.replace(tzinfo=_dt.UTC)
+        return (moment - _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)) / _dt.timedelta(days=1)
     text = str(date).strip()
     if len(text) == 7 and text[4] == "-":
         text += "-15"  # a month: its middle (monthly tables' values are the month's)
