@@ -80,6 +80,14 @@ class SatelliteInputs:
         described = (self.mass_kg, self.area_m2, self.mass_per_area_kg_m2, self.drag_coefficient, self.shape)
         return any(value is not None for value in described)
 
+    @property
+    def drag_absorbs_scale(self) -> bool:
+        """Whether element sets' drag, calibrated or fitted to the air, flies: it absorbs any density scale.
+
+        So unless the satellite is described or the drag is one set's 2 B* / rho0 as read (``bstar-raw``).
+        """
+        return not self.given and self.drag_from != "bstar-raw"
+
 
 @dataclass(frozen=True)
 class DragSource:

@@ -202,14 +202,14 @@ def element_set_lifetime(
         from orbit_env.decay.solar_record import load_record
 
         scenario = Scenario(MsisAir(load_record(), start, version=msis_version))
-    elif scenario.epoch_days is not None and abs(scenario.epoch_days - start) > 1.0 / 86400.0:
+    elif scenario.epoch_days is not None and not latest.measured_at(scenario.epoch_days):
         raise ValueError(
             f"the scenario starts at {np.datetime64(round(scenario.epoch_days * 86400.0), 's')}Z: the decay starts "
             "at the element set's epoch "
             f"({latest.epoch_iso}), where its orbit was measured (Scenario.at_epoch moves a scenario there)"
         )
-    own = satellite is None or not satellite.given
-    if own and (satellite is None or satellite.drag_from != "bstar-raw") and scenario.density_scale != 1.0:
+    inputs = satellite or SatelliteInputs()
+    if inputs.drag_absorbs_scale and scenario.density_scale != 1.0:
         raise ValueError(
             f"a density scale of {scenario.density_scale:g} changes nothing when the drag is calibrated to the air "
             "from element sets (the calibration absorbs it); to fly a scale, describe the satellite"
@@ -218,7 +218,7 @@ def element_set_lifetime(
     shift = offset_km(REFERENCE)
     sphere = (latest.flown_perigee_km + shift, latest.flown_apogee_km + shift)
     drag = drag_source(
-        satellite or SatelliteInputs(),
+        inputs,
         air,
         inclination,
         sphere_heights_km=sphere,

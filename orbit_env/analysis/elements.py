@@ -118,6 +118,10 @@ class ElementSet:
 
         return str(np.datetime64(round(self.epoch_days * 86400.0), "s")) + "Z"
 
+    def measured_at(self, days: float) -> bool:
+        """Whether ``days`` [unix days] is the set's epoch (the same second, any form): where a decay of it starts."""
+        return self.epoch_days is not None and abs(days - self.epoch_days) <= 1.0 / 86400.0
+
 
 def mean_elements(semi_major_axis_km: float, eccentricity: float, inclination_deg: float = 0.0) -> ElementSet:
     """An element set from a mean semi-major axis and eccentricity (heights above the equatorial radius).

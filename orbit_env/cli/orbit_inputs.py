@@ -196,8 +196,7 @@ def _check_element_set_options(args: argparse.Namespace, from_sets: bool, latest
         raise ValueError(
             "--drag-from says what an element set's drag is read from: it goes with --tle (or --batch sets)"
         )
-    own_drag = not satellite_inputs(args).given and drag_from != "bstar-raw"
-    if from_sets and own_drag and getattr(args, "density_scale", 1.0) != 1.0:
+    if from_sets and satellite_inputs(args).drag_absorbs_scale and getattr(args, "density_scale", 1.0) != 1.0:
         raise ValueError(
             "--density-scale changes nothing when the drag is calibrated to the air from element sets (the "
             "calibration absorbs the scale); to fly a fitted scale, give the satellite: --mass and --area (or --shape)"
@@ -205,7 +204,7 @@ def _check_element_set_options(args: argparse.Namespace, from_sets: bool, latest
     from orbit_env.decay.solar import unix_days
 
     from_tle = latest is not None and getattr(args, "tle", None) is not None and args.epoch is not None
-    if from_tle and abs(unix_days(args.epoch) - latest.epoch_days) > 1.0 / 86400.0:  # the same second, any form
+    if from_tle and not latest.measured_at(unix_days(args.epoch)):
         raise ValueError(
             f"--epoch {args.epoch}: the decay starts at the element set's epoch ({latest.epoch_iso}), where its orbit "
             "was measured; drop --epoch (to fly that orbit from another date, give its heights with --perigee/--apogee)"
