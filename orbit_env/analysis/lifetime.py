@@ -326,10 +326,13 @@ def lifetime(
                 f"chunk_days={chunk_days!r} steps a dated decay (an epoch, or activity that changes); this air is "
                 "one fixed profile"
             )
-    elif any(value is not None for value in {**keywords, "chunk_days": chunk_days}.values()) or density_scale != 1.0:
-        named = {**keywords, "chunk_days": chunk_days}
-        given = ", ".join(name for name, value in named.items() if value is not None) or "density_scale"
-        raise ValueError(f"give the air either as a scenario or as keywords, not both (here: scenario and {given})")
+    else:
+        given = ", ".join(name for name, value in {**keywords, "chunk_days": chunk_days}.items() if value is not None)
+        if given or density_scale != 1.0:
+            raise ValueError(
+                "give the air either as a scenario or as keywords, not both (here: scenario and "
+                f"{given or 'density_scale'})"
+            )
     method = method or default_method(scenario, hp_m, ha_m)
     if scenario.time_varying:
         result = _lifetime_under_activity(
