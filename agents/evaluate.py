@@ -93,7 +93,8 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     returned = policy.predict(observations, deterministic=True)
     if not (isinstance(returned, tuple) and len(returned) == 2):
         raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
-    kind = np.asarray(returned[0]).dtype.kind
+    dtype = np.asarray(returned[0]).dtype
+    kind = dtype.kind
     if kind == "b":
         raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
     try:
@@ -110,7 +111,6 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     if isinstance(space, gymnasium.spaces.Discrete):
         allowed = f"integers in [{space.start}, {space.start + space.n - 1}]"
         if kind not in "iu":
-            dtype = np.asarray(returned[0]).dtype
             raise ValueError(
                 f"{name}.predict returned {dtype} actions for a discrete space ({float(actions.flat[0])!r} first); "
                 f"allowed: {allowed} (the environment refuses a float action, 2.0 too)"
