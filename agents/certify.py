@@ -9,7 +9,9 @@ reports the gap it finds: a lower bound on the DP policy's distance to the optim
 For each of ``episodes`` seeded start orbits (those of ``orbit-env evaluate``):
 
 1. the DP policy plays the episode; its return is the reference and its actions the
-   first plan;
+   first plan (certifying a policy of one's own, ``policy=``: that policy's return is the
+   reference, and the first plan is its actions or the DP policy's, whichever earns more,
+   so that the gap found is at least what the DP already shows);
 2. every open-loop plan of burns on the first `EARLY_STEPS` steps (all
    combinations of `EARLY_BURNS`), then coasting;
 3. hill climbing from the best plan so far: ``rounds`` rounds of ``perturbations``
@@ -229,6 +231,9 @@ class _Optimum(NamedTuple):
     returns: FloatArray
     burns_m_s: FloatArray  # (starts, horizon): its plan
     start_dates: tuple[str, ...] = ()  # the solar task's missions' first days
+    # Where the search starts if not from the plan above (a policy's certificate: the DP policy's where it is better).
+    first_plans: FloatArray | None = None
+    first_returns: FloatArray | None = None
 
 
 def _start_heights(plans: _Plans) -> tuple[FloatArray, FloatArray]:
@@ -258,6 +263,11 @@ def _known_density_optimum(
     plans = _Plans(env_id, heights)
     zero = np.zeros((episodes, plans.horizon))
     returns, burns = plans.score(np.arange(episodes), zero, policy or dp_policy(env_id, dp_lookahead, dp_rollout))
+    if policy is not None:  # the search starts from the better of the policy's plan and the DP policy's
+        dp_returns, dp_burns = plans.score(np.arange(episodes), zero, dp_policy(env_id))
+        better = dp_returns > returns
+        first = np.where(better[:, None], dp_burns, burns)
+        return _Optimum(plans, returns, burns, first_plans=first, first_returns=np.where(better, dp_returns, returns))
     return _Optimum(plans, returns, burns)
 
 
@@ -358,6 +368,9 @@ def certify(
             f"{env_id}: the certificate searches plans against each mission's DP policy only; score your policy "
             "with orbit_env.agents.solar.evaluate_solar (learned={...}) against that DP"
         )
+    if policy is not None and (dp_rollout or dp_lookahead != 1):
+        given = "dp_rollout" if dp_rollout else f"dp_lookahead={dp_lookahead}"
+        raise ValueError(f"{given} chooses the DP policy to certify; with policy= the policy given is certified")
     say = progress or (lambda text: None)
     start_time = time.perf_counter()
     say("dp (solving and playing)")
@@ -371,7 +384,10 @@ def certify(
     replay_error = 0.0
     if env_id in SOLAR_ENV_IDS:  # the burns the DP asked for, as an open-loop plan in the env, give its return back
         replay_error = float(np.max(np.abs(plans.score(everyone, dp_burns) - dp_returns)))
-    best, best_returns = dp_burns.copy(), dp_returns.copy()
+    if optimum.first_plans is None:
+        best, best_returns = dp_burns.copy(), dp_returns.copy()
+    else:
+        best, best_returns = optimum.first_plans.copy(), optimum.first_returns.copy()
     early = _early_plans(plans)
     say(f"{early.shape[0]} early plans per start")
     chunk = max(1, 65536 // early.shape[0])

@@ -9,6 +9,7 @@ The seeds differ from training's (``agents/ppo.toml`` trains with seed 0).
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -88,15 +89,28 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     environment itself would refuse is an error naming the policy, not an action quietly rounded or wrapped
     (2.7 was the 30 m/s burn, -1 the largest).
     """
-    name = type(policy).__name__
     rows = len(observations)
-    returned = policy.predict(observations, deterministic=True)
-    if not (isinstance(returned, tuple) and len(returned) == 2):
-        raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
+    if not hasattr(policy, "predict") and callable(policy):  # a plain function: observations -> actions
+        name = getattr(policy, "__name__", type(policy).__name__)
+        returned = (policy(observations), None)
+    else:
+        name = type(policy).__name__
+        _check_predict(policy, name, observations)
+        returned = policy.predict(observations, deterministic=True)
+        if not (isinstance(returned, tuple) and len(returned) == 2):
+            raise ValueError(f"{name}.predict must return (actions, state), as Stable-Baselines3's does")
+        if returned[1] is not None:
+            raise ValueError(
+                f"{name}.predict returned a state ({type(returned[1]).__name__}): the episodes are scored with "
+                "memoryless calls, predict(observations, deterministic=True), its state never passed back; every "
+                "observation holds the clock, the tank and the orbit, so decide from it (return the state given, None)"
+            )
     dtype = np.asarray(returned[0]).dtype
     kind = dtype.kind
     if kind == "b":
         raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
+    if kind in "OSUV":
+        raise ValueError(f"{name}.predict returned {dtype} actions; allowed: numbers of the action space")
     try:
         actions = np.asarray(returned[0], dtype=np.float64)
     except (TypeError, ValueError):
@@ -119,7 +133,24 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
         if not inside.all():
             raise ValueError(f"{name}.predict returned action {actions[~inside][0]:g}; allowed: {allowed}")
         return actions.astype(np.int64)
+    if np.dtype(space.dtype).kind == "f":  # 1e300 is finite, not in float32
+        beyond = np.abs(actions) > np.finfo(space.dtype).max
+        if beyond.any():
+            raise ValueError(f"{name}.predict returned action {actions[beyond][0]:g}, beyond {space.dtype}")
     return actions.astype(space.dtype)
+
+
+def _check_predict(policy: Any, name: str, observations: Any) -> None:
+    """ValueError unless ``policy.predict`` takes (observations, deterministic=True), as Stable-Baselines3's does."""
+    try:
+        inspect.signature(policy.predict).bind(observations, deterministic=True)
+    except TypeError:
+        raise ValueError(
+            f"{name}.predict must take predict(observation, state=None, episode_start=None, deterministic=False), "
+            "as Stable-Baselines3's does (or score a plain function observations -> actions)"
+        ) from None
+    except ValueError:  # no signature to read (a builtin): called as it is
+        pass
 
 
 def run_episodes(
@@ -146,21 +177,26 @@ def run_episodes(
     dv = np.zeros(episodes)
     running = np.ones(episodes, dtype=bool)
     actions = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
-    while running.any():
-        # Only the first episode of each satellite is scored: the policy acts on the
-        # running ones (the restarted ones coast), so a DP reads only the current stage.
-        rows = np.flatnonzero(running)
-        if hasattr(policy, "bind"):
-            policy.bind(env, rows)  # an oracle reads the hidden state it is told
-        actions[...] = 0
-        actions[rows] = predicted_actions(policy, obs[rows], env.single_action_space)
-        obs, reward, terminated, truncated, info = env.step(actions)
-        burn = np.asarray(info["burn_m_s"], dtype=np.float64)
-        returns += np.where(running, reward, 0.0)
-        days += np.where(running, reward + cost * burn, 0.0)
-        dv += np.where(running, burn, 0.0)
-        running &= ~(terminated | truncated)
-    env.close()
+    oracle = policy if isinstance(policy, OracleDP) else None  # reads the hidden state it is told; no one else
+    try:
+        while running.any():
+            # Only the first episode of each satellite is scored: the policy acts on the
+            # running ones (the restarted ones coast), so a DP reads only the current stage.
+            rows = np.flatnonzero(running)
+            if oracle is not None:
+                oracle.bind(env, rows)
+            actions[...] = 0
+            actions[rows] = predicted_actions(policy, obs[rows], env.single_action_space)
+            obs, reward, terminated, truncated, info = env.step(actions)
+            burn = np.asarray(info["burn_m_s"], dtype=np.float64)
+            returns += np.where(running, reward, 0.0)
+            days += np.where(running, reward + cost * burn, 0.0)
+            dv += np.where(running, burn, 0.0)
+            running &= ~(terminated | truncated)
+    finally:
+        if oracle is not None:
+            oracle.bind(None)  # no stale episodes to read afterwards
+        env.close()
     return Episodes(returns=returns, lifetime_days=days, dv_m_s=dv)
 
 
@@ -257,17 +293,19 @@ def format_table(
 ) -> str:
     """The evaluation as a text table for people (``paired``: results of `paired_difference`)."""
     width = policy_width(table)
-    lines = [
-        f"{env_id}: {episodes} episodes (seed {seed})",
-        f"{'policy':<{width}} {'return':>17} {'lifetime [d]':>13} {'dv [m/s]':>9} {'capture':>8}",
-    ]
+    spread = max([5, *(len(f"{row['std_return']:.1f}") for row in table.values())])  # 1020.9 too
+    captured = any(row["capture"] is not None for row in table.values())  # else no capture column
+    header = f"{'policy':<{width}} {'return':>{12 + spread}} {'lifetime [d]':>13} {'dv [m/s]':>9}"
+    lines = [f"{env_id}: {episodes} episodes (seed {seed})", header + (f" {'capture':>8}" if captured else "")]
     for name, row in table.items():
-        capture = "" if row["capture"] is None else f"{row['capture']:8.1%}"
-        lines.append(
-            f"{name:<{width}} {row['mean_return']:8.1f} +- {row['std_return']:5.1f} {row['mean_lifetime_days']:13.1f} "
-            f"{row['mean_dv_m_s']:9.1f} {capture:>8}"
+        line = (
+            f"{name:<{width}} {row['mean_return']:8.1f} +- {row['std_return']:{spread}.1f} "
+            f"{row['mean_lifetime_days']:13.1f} {row['mean_dv_m_s']:9.1f}"
         )
-    if any(row["capture"] is not None for row in table.values()):
+        if captured:
+            line += f" {'' if row['capture'] is None else format(row['capture'], '8.1%'):>8}"
+        lines.append(line)
+    if captured:
         lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
     for pair in paired:
         lines.append(
@@ -524,17 +562,28 @@ class OracleDP:
         self.rows: Any = None
 
     def bind(self, env: Any, rows: Any = None) -> None:
-        """The vector env whose hidden density the oracle reads; ``rows``: whose observations come next (None: all)."""
+        """The vector env whose hidden density the oracle reads (None: none).
+
+        ``rows``: whose observations come next (None: all). `run_episodes` binds it at every
+        step and unbinds it at the end.
+        """
         self.env = env
         self.rows = rows
 
     def predict(self, observation: Any, state: Any = None, episode_start: Any = None, deterministic: bool = True):
         """Each satellite acts by the DP of its density rung."""
         if self.env is None:
-            raise ValueError("OracleDP needs bind(vector_env) before predict")
+            raise ValueError(
+                "OracleDP reads the hidden density of the episodes it is bound to: score it directly with "
+                "run_episodes or evaluate (not inside another policy), or bind(vector_env) first"
+            )
         obs = np.atleast_2d(np.asarray(observation))
         scale = self.env.state["density_scale"]
         scale = scale if self.rows is None else scale[self.rows]
+        if scale.shape[0] != obs.shape[0]:
+            raise ValueError(
+                f"OracleDP is bound to {scale.shape[0]} satellites but was given {obs.shape[0]} observations"
+            )
         rung = np.abs(np.log(scale)[:, None] - np.log(self.scales)[None, :]).argmin(axis=1)
         actions = np.zeros(obs.shape[0], dtype=np.int64)
         for k in np.unique(rung):
@@ -558,8 +607,9 @@ def dp_policy(env_id: str, lookahead: int = 1, rollout: bool = False) -> Predict
 
     base = task_of(env_id)
     if base.density.scale_range[0] != base.density.scale_range[1]:
-        if rollout:
-            raise ValueError(f"{env_id}: the rollout needs a known, constant density (the DP's task)")
+        if rollout or lookahead != 1:
+            what = "the rollout" if rollout else f"the lookahead {lookahead}"
+            raise ValueError(f"{env_id}: {what} needs a known, constant density (the DP's task)")
         return OracleDP(base.config, base.density.scale_range)
     scale = base.density.nominal_scale
     if base.continuous:

@@ -56,7 +56,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     if args.plot and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
     if args.certify:
-        given = [flag for flag, value in (("--model", args.model), ("--plot", args.plot)) if value]
+        given = [
+            flag for flag, value in (("--model", args.model), ("--plot", args.plot), ("--no-dp", args.no_dp)) if value
+        ]
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
         return _certify(args, say)
