@@ -11,6 +11,8 @@ was optimistic.
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -18,6 +20,7 @@ import pytest
 import orbit_env  # noqa: F401  (registers the environments)
 import orbit_env.agents.dp as dp
 from orbit_env.agents.dp import DPPolicy, solve
+from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig
 
@@ -156,7 +159,16 @@ def test_coasting_where_the_satellite_outlives_the_mission_changes_no_value(monk
     # coasts are then interpolated, and the values stored in steps of 0.01 day).
     config = OrbitRaisingConfig(**{**CONFIG.__dict__, "propellant_cost_per_m_s": cost})
     restricted = dp._backward_induction(config, GRID, 1.0, False)
-    assert restricted.coast_certain_stages == (60 if cost == 0.05 else 48)
+    # The stages are the largest k with c0 k < cost, c0 the most days a step's K revolutions gain per m/s of
+    # perigee burn by the longer period, derived here: P = 2 pi sqrt(a^3 / mu) and vis-viva a = 1 / (2/r - v^2/mu)
+    # give dP/dv = 3 P a v / mu, largest at the 4000 km apogee cap over perigees 100-1100 km.
+    r_p = EARTH_RADIUS_M + np.linspace(100e3, 1100e3, 1001)
+    a = 0.5 * (r_p + EARTH_RADIUS_M + 4000e3)
+    speed = np.sqrt(MU_EARTH_M3_S2 * (2.0 / r_p - 1.0 / a))
+    period = 2.0 * np.pi * np.sqrt(a**3 / MU_EARTH_M3_S2)
+    c0 = config.revolutions_per_step * np.max(3.0 * period * a * speed / MU_EARTH_M3_S2) / 86400.0
+    assert restricted.coast_certain_stages == min(math.ceil(cost / c0) - 1, config.horizon_steps)
+    assert restricted.coast_certain_stages == (60 if cost == 0.05 else 48)  # both cases as the comment says
     monkeypatch.setattr(dp, "_coast_certain_stages", lambda model: 0)
     everywhere = dp._backward_induction(config, GRID, 1.0, False)
     assert everywhere.stored_values == (config.horizon_steps + 1 - 1) * everywhere.num_states

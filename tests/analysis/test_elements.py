@@ -59,6 +59,13 @@ def test_checksums_of_published_lines():
     assert tle_checksum(ISS[0]) == 7 and tle_checksum(ISS[1]) == 7
 
 
+def test_ndot_is_twice_line_ones_field():
+    # Line 1's columns 34-43 hold the first derivative of the mean motion divided by two (Hoots & Roehrich,
+    # Spacetrack Report #3; CelesTrak's "TLE format"): -.00002182 rev/day^2 in the ISS set is ndot/2.
+    assert parse_tle(*ISS).ndot_rev_day2 == pytest.approx(2 * -0.00002182, rel=1e-12)
+    assert parse_tle(*CUBESAT[1:]).ndot_rev_day2 == pytest.approx(2 * 0.00002, rel=1e-12)
+
+
 def test_element_set_orbit_and_drag_from_closed_forms():
     name, line1, line2 = CUBESAT
     elements = parse_tle(line1, line2, name)

@@ -46,6 +46,11 @@ def test_fixed_profile_percentiles_and_probability_from_the_log_normal():
     binomial = math.sqrt(expected * (1 - expected) / 20_000)
     assert spread.compliance_probability(rule_days / 365.25) == pytest.approx(expected, abs=4 * binomial)
     assert "solar_forecast" not in spread.sources  # a constant activity has no forecast to vary
+    # Sample by sample: a denser air or a larger drag parameter shortens the life (the decay rate is linear
+    # in rho c, Eq. 3.4), so each life is d0 / (density factor x drag factor), not d0 times it (the
+    # percentiles above cannot tell the two apart: the factors are log-normal around 1).
+    _, density, drag = U.sample_factors(20_000, 1)
+    np.testing.assert_allclose(spread.days, d0 / (density * drag), rtol=1e-12)
 
 
 @pytest.mark.slow
