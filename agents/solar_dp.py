@@ -175,8 +175,10 @@ class SolarDP:
         ending = _grid_states(task, grid, 0.5 * grid.levels[-1], end_day)
         need, _ = solar_task.disposal(task, ending)
         need = need.reshape(n_l, n_t)
-        value = -cost * need[:, :, None] - np.where(
-            need[:, :, None] > grid.levels[None, None, :] + 1e-9, task.penalty_days, 0.0
+        # As the task charges it (`solar_task._rule_at_the_end`): the burn's propellant, or the penalty alone
+        # where the tank cannot pay the burn (no burn is made then).
+        value = np.where(
+            need[:, :, None] > grid.levels[None, None, :] + 1e-9, -task.penalty_days, -cost * need[:, :, None]
         )
         value[:, 0, :] = 0.0  # re-entered: nothing left to dispose of
         # Masses for the coasts (tank full, half, empty) and each level's drag parameter.

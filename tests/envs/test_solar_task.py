@@ -17,7 +17,16 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import orbit_env
-from orbit_env.agents.solar import AllAtOnce, LifeThreshold, Never, PerigeeThreshold, by_observation, fly, starts
+from orbit_env.agents.solar import (
+    AllAtOnce,
+    LifeThreshold,
+    Never,
+    PerigeeThreshold,
+    by_observation,
+    fly,
+    fly_from,
+    starts,
+)
 from orbit_env.agents.solar_dp import SolarDP
 from orbit_env.analysis.air.msis import MsisAir
 from orbit_env.analysis.lifetime import Satellite
@@ -31,6 +40,7 @@ from orbit_env.envs import SOLAR_ENV_ID
 from orbit_env.envs import solar_kernel as sk
 from orbit_env.envs import solar_task as st
 from orbit_env.envs.kernel import JIT_VARIABLE
+from orbit_env.envs.task import update_satellite
 from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
 
 TEST_TASK = st.SolarTask(mission=st.SolarMission(solar_split="test"))
@@ -411,6 +421,26 @@ def test_the_optimum_beats_every_rule_on_its_mission() -> None:
     # mission (the grid is pessimistic here), 30 days is 2% of a mission's return.
     start = st.start(task, np.random.default_rng(0), 1, options)
     assert dp.value(start)[0] == pytest.approx(dp_return, abs=30.0)
+
+
+def test_the_optimum_charges_a_mission_that_cannot_comply_as_the_task_does() -> None:
+    # An empty tank on an orbit that outlives the rule: the task charges the penalty alone (it makes no burn);
+    # the DP's value had charged the burn's propellant too (132 days more here: -448.27). The grid's coasts
+    # against the flown ones: 0.013 day apart on this mission; 0.1 day allows for the grid, not the burn.
+    task = TEST_TASK
+    options = {"perigee_km": 550.0, "apogee_km": 560.0, "start_date": "2010-01-01"}
+
+    def empty() -> st.BatchState:
+        state = st.start(task, np.random.default_rng(0), 1, options)
+        state.mass_kg = state.dry_mass_kg + 0.0
+        update_satellite(task, state)
+        return state
+
+    flown = fly_from(task, empty(), lambda states: np.zeros(states.size))
+    assert not flown.complies[0] and flown.days_in_orbit[0] == task.mission_days
+    assert flown.returns[0] == pytest.approx(task.mission_days - task.penalty_days, abs=1e-9)
+    dp = SolarDP(task, float(st.start_options(empty())["start_day"][0]))
+    assert dp.value(empty())[0] == pytest.approx(flown.returns[0], abs=0.1)
 
 
 def test_the_rollout_on_the_dp_never_flies_worse_than_the_dp() -> None:
