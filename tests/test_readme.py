@@ -60,8 +60,8 @@ def console_examples():
 NUMBER = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\dZ|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 
 
-def same_line(got, expected):
-    """Same text; numbers within 1e-5 relative or one unit of the last printed digit;
+def same_line(got, expected, floor=0.0):
+    """Same text; numbers within 1e-5 relative (of ``floor`` at least) or one unit of the last printed digit;
     times within 1 hour (1e-5 of a 12-year life is 1.1 hours)."""
     got_numbers, expected_numbers = NUMBER.findall(got), NUMBER.findall(expected)
     if NUMBER.sub("#", got) != NUMBER.sub("#", expected) or len(got_numbers) != len(expected_numbers):
@@ -73,7 +73,7 @@ def same_line(got, expected):
                 return False
         else:
             digits = len(e.partition("e")[0].partition(".")[2])
-            if abs(float(g) - float(e)) > max(1e-5 * abs(float(e)), 10.0**-digits * 1.0001):
+            if abs(float(g) - float(e)) > max(1e-5 * max(abs(float(e)), floor), 10.0**-digits * 1.0001):
                 return False
     return True
 
@@ -85,6 +85,7 @@ def test_same_line_tolerance():
     assert not same_line("lifetime 4523.80 days", "lifetime 4523.69 days")
     assert not same_line("lifetime 4523.69 hours", "lifetime 4523.69 days")
     assert same_line("nu 1.117e+04 m", "nu 1.117e+04 m")
+    assert not same_line("1.76077", "1.76086") and same_line("1.76077", "1.76086", floor=108.2)
 
 
 def test_readme_has_python_and_console_examples():
@@ -175,10 +176,17 @@ def test_lifetime_howto_console_examples(steps, tmp_path, monkeypatch):
         if command.startswith("cat "):
             Path(command[4:]).write_text("\n".join(expected) + "\n")
             continue
+        floor = 0.0
         if command.startswith(("head -", "tail -")):
             end, count, name = command.split()
             lines = Path(name).read_text().splitlines()
             got = lines[: int(count[1:])] if end == "head" else lines[-int(count[1:]) :]
+            if lines[0].endswith("nu_remaining"):
+                # A trajectory's last column is the nu left, the life's nu (its first row's) less the nu
+                # flown: its error is 1e-5 of the life's nu, not of a small remainder (1.76 of 108.2 the
+                # day before re-entry, 5e-5 relative apart on an AMD EPYC and the machine the page was
+                # made on); every number of the row is held to that.
+                floor = float(lines[1].split(",")[-1])
         else:
             got, status = run_command(command, monkeypatch)
             failed = any(line.startswith("orbit-env: error") for line in expected)
@@ -188,7 +196,7 @@ def test_lifetime_howto_console_examples(steps, tmp_path, monkeypatch):
             if "..." in want:  # a path the reader's machine names its own way
                 assert re.fullmatch(re.escape(want).replace(re.escape("..."), ".*"), line), (command, line, want)
             else:
-                assert same_line(line, want), (command, line, want)
+                assert same_line(line, want, floor), (command, line, want)
 
 
 def test_lifetime_howto_runs_most_of_its_console_blocks():
