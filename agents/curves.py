@@ -28,13 +28,14 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import as_completed
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from orbit_env.agents.sweep import bootstrap_interval, capture_of, iqm, score_model, train_trial
+from orbit_env.workers import spawned_pool
 
 #: The algorithms of the curves: SB3's PPO with its defaults, and the project's recipe.
 CURVE_ALGOS = ("ppo", "ppo_recipe")
@@ -187,10 +188,12 @@ def curves(
     if done:
         say(f"{len(done)} runs already written in {out / 'curves'}; {len(jobs)} to go")
     if workers > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(min(workers, len(jobs))) as pool:
-            for run in pool.map(_run_curve, jobs):
-                done.append(run)
-                say(_finished(run, len(done), len(algos) * seeds))
+        # Spawned workers, stopped at once if this process is interrupted (Ctrl-C, SIGTERM: a plain pool waited for
+        # them to finish their runs); each run is reported as it ends, whatever its place in the list.
+        with spawned_pool(min(workers, len(jobs))) as pool:
+            for future in as_completed([pool.submit(_run_curve, job) for job in jobs]):
+                done.append(future.result())
+                say(_finished(done[-1], len(done), len(algos) * seeds))
     else:
         for job in jobs:
             done.append(_run_curve(job))

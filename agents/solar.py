@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Mapping
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 from typing import Any
@@ -38,6 +37,7 @@ from orbit_env.envs.solar_task import SOLAR_OBS_INDEX, SOLAR_OBS_NAMES, SolarMis
 from orbit_env.envs.state import BatchState
 from orbit_env.envs.task import DV_SCALE_M_S, HEIGHT_SCALE_M, observation_batch
 from orbit_env.physics.orbit import dv_to_lower_perigee_m_s
+from orbit_env.workers import worker_pool
 
 FloatArray = NDArray[np.float64]
 
@@ -398,7 +398,7 @@ def map_missions(
     jobs = [(task, {key: float(value[i]) for key, value in options.items()}) for i in range(n)]
     count = workers or min(os.cpu_count() or 1, 8)
     if count > 1 and n > 1:
-        with ProcessPoolExecutor(count) as pool:
+        with worker_pool(count) as pool:  # stopped at once if this process is interrupted (Ctrl-C, SIGTERM)
             return list(pool.map(solve, jobs))
     return [solve(job) for job in jobs]
 

@@ -32,6 +32,8 @@ from orbit_env.agents.shaping import SHAPINGS
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
+#: A run's files beside ``checkpoints/`` and ``tensorboard/`` (``--force`` deletes them with the checkpoints).
+_RUN_FILES = ("model.zip", "best_model.zip", "best_model_replaced.zip", "evaluations.json", "config.json")
 
 
 @dataclass(frozen=True)
@@ -325,7 +327,10 @@ class BestModelCallback(BaseCallback):
         if resume is not None and (self.save_dir / "evaluations.json").is_file():
             # A resumed run's best model stays the best unless beaten; the scores after its checkpoint are
             # of the branch it replaces (a checkpoint older than the last score: they would appear twice).
-            scores = json.loads((self.save_dir / "evaluations.json").read_text())
+            try:
+                scores = json.loads((self.save_dir / "evaluations.json").read_text())
+            except json.JSONDecodeError as error:
+                raise ValueError(f"{self.save_dir / 'evaluations.json'} is not readable JSON ({error})") from None
             self.evaluations = [e for e in scores if e["timesteps"] <= resume]
             self.best_mean = max((e["mean_return"] for e in self.evaluations), default=-float("inf"))
             replaced = max((e["mean_return"] for e in scores if e["timesteps"] > resume), default=-float("inf"))
@@ -359,10 +364,15 @@ class BestModelCallback(BaseCallback):
         self.save_dir.mkdir(parents=True, exist_ok=True)
         if mean > self.best_mean:
             self.best_mean = mean
-            self.model.save(self.best_model_path, exclude=["env", "tensorboard_log"])
+            partial = self.save_dir / ".partial"
+            partial.mkdir(exist_ok=True)
+            self.model.save(partial / self.best_model_path.name, exclude=["env", "tensorboard_log"])
+            (partial / self.best_model_path.name).replace(self.best_model_path)  # whole or not at all
         self.logger.record("eval/best_mean_reward", self.best_mean)
         self.evaluations.append({"timesteps": int(self.model.num_timesteps), "mean_return": mean})
-        (self.save_dir / "evaluations.json").write_text(json.dumps(self.evaluations, indent=1) + "\n")
+        written = self.save_dir / "evaluations.json.partial"
+        written.write_text(json.dumps(self.evaluations, indent=1) + "\n")
+        written.replace(self.save_dir / "evaluations.json")  # whole or not at all
         return mean
 
 
@@ -428,8 +438,56 @@ class ReturnsCallback(BaseCallback):
             self.logger.record("rollout/shaped_return", float(np.mean([e["r"] for e in episodes])))
 
 
+class TrainingInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or SIGTERM) stopped `train`; ``checkpoint`` holds the run up to its last whole rollout."""
+
+    def __init__(self, checkpoint: Path, timesteps: int) -> None:
+        super().__init__(f"interrupted; saved {checkpoint} ({timesteps} timesteps)")
+        self.checkpoint = checkpoint
+        self.timesteps = timesteps
+
+
+def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
+    """``rl_model_N_steps.zip`` (N = ``timesteps``) and its reward statistics, each written whole or not at all.
+
+    Each file is written in ``folder/.partial`` and moved into ``folder`` (a rename, atomic): the
+    statistics first, so that a checkpoint that exists has them (a run killed while SB3's own callback
+    wrote had left a 0-byte or truncated zip, or a zip without its statistics, which resumed with fresh ones).
+    """
+    partial = folder / ".partial"
+    partial.mkdir(parents=True, exist_ok=True)
+    path = folder / f"rl_model_{timesteps}_steps.zip"
+    normalize = model.get_vec_normalize_env()
+    if normalize is not None:
+        normalize.save(str(partial / _vecnormalize_path(path).name))
+        (partial / _vecnormalize_path(path).name).replace(_vecnormalize_path(path))
+    model.save(partial / path.name, exclude=["env", "tensorboard_log"])
+    (partial / path.name).replace(path)
+    return path
+
+
+class CheckpointEvery(BaseCallback):
+    """`save_checkpoint` every ``every_calls`` environment steps (SB3's CheckpointCallback, its files whole)."""
+
+    def __init__(self, every_calls: int, folder: Path) -> None:
+        super().__init__(verbose=0)
+        self.every_calls = max(int(every_calls), 1)
+        self.folder = folder
+
+    def _on_step(self) -> bool:
+        if self.n_calls % self.every_calls == 0:
+            save_checkpoint(self.model, self.folder, int(self.model.num_timesteps))
+        return True
+
+
+def newest_checkpoint(out_dir: str | Path) -> Path | None:
+    """The checkpoint of most timesteps in ``out_dir/checkpoints``, or None."""
+    found = [(int(p.stem.split("_")[2]), p) for p in Path(out_dir, "checkpoints").glob("rl_model_*_steps.zip")]
+    return max(found)[1] if found else None
+
+
 def _vecnormalize_path(checkpoint: Path) -> Path:
-    """The reward statistics CheckpointCallback saves beside ``rl_model_N_steps.zip``."""
+    """The reward statistics `save_checkpoint` writes beside ``rl_model_N_steps.zip`` (SB3's own naming)."""
     return checkpoint.with_name(checkpoint.name.replace("rl_model_", "rl_model_vecnormalize_")).with_suffix(".pkl")
 
 
@@ -464,19 +522,21 @@ def train(
         num_envs: Satellites stepped together (default: the config's).
         env_id: Environment (default: the config's ``env_id``); the ``[env]`` keywords still apply.
         resume: A checkpoint (``checkpoints/rl_model_N_steps.zip``) to continue from,
-            up to the same total budget.
-        force: Overwrite a finished run in ``out_dir`` (otherwise it is kept: ValueError).
+            up to the same total budget, under the run's settings (``config.json``).
+        force: Start over in ``out_dir``, deleting the run there, finished or not (otherwise it is
+            kept: ValueError); with ``resume``, replace a finished run's model.
         progress: Show a progress bar.
         extra_callbacks: More SB3 callbacks that see the training (`orbit_env.agents.curves` scores the policy).
 
     Raises:
-        ValueError: a bad config or argument, a finished run in ``out_dir`` without
-            ``force``, a missing checkpoint.
+        ValueError: a bad config or argument, a run in ``out_dir`` without ``force`` (or
+            ``resume`` for an unfinished one), a missing checkpoint, a resume under other settings.
+        TrainingInterrupted: Ctrl-C (or SIGTERM through the command line) stopped the run: its
+            checkpoint at the last whole rollout is saved (``checkpoint``), the run can be resumed from it.
     """
     try:
         import torch
         from stable_baselines3 import PPO
-        from stable_baselines3.common.callbacks import CheckpointCallback
         from stable_baselines3.common.vec_env import VecNormalize
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
@@ -493,12 +553,33 @@ def train(
     timesteps = timesteps_to_train(config["total_timesteps"], config)
     out = Path(out_dir)
     model_path = out / "model.zip"
-    if model_path.exists() and not force and resume is None:
-        raise ValueError(f"{model_path} exists: a finished run is kept; pass --force to overwrite it")
     checkpoint = None if resume is None else Path(resume)
     if checkpoint is not None and not checkpoint.is_file():
         raise ValueError(f"no checkpoint at {checkpoint}")
+    if model_path.exists() and not force:
+        if checkpoint is None:
+            raise ValueError(f"{model_path} exists: a finished run is kept; pass --force to overwrite it")
+        raise ValueError(f"{model_path} exists: resuming from {checkpoint} would replace a finished run; pass --force")
+    newest = newest_checkpoint(out)
+    if checkpoint is None and not model_path.exists() and not force and (newest or (out / "evaluations.json").exists()):
+        named = f"; continue it with --resume {newest}" if newest is not None else ""
+        raise ValueError(f"{out} holds an unfinished run{named}, or pass --force to start over (its files deleted)")
+    if force and checkpoint is None:  # a new run: the old one's files would mix with its own
+        for old in [*Path(out, "checkpoints").glob("rl_model_*"), *(out / name for name in _RUN_FILES)]:
+            old.unlink(missing_ok=True)
+    settings = out / "config.json"  # the run's settings, so that a resume continues the same run
+    if checkpoint is not None and settings.is_file():
+        started = json.loads(settings.read_text())
+        changed = sorted(
+            key for key in {*started, *config} if key != "total_timesteps" and started.get(key) != config.get(key)
+        )
+        if changed:
+            raise ValueError(
+                f"{out} was trained with other settings ({', '.join(changed)} differ from {settings}): give the "
+                "run's --config and options to resume it (--timesteps may change)"
+            )
     out.mkdir(parents=True, exist_ok=True)
+    settings.write_text(json.dumps(config, indent=1, sort_keys=True) + "\n")
     torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
     seed = int(config["seed"])
     venv: Any = training_env(config)
@@ -519,9 +600,7 @@ def train(
     every = int(config["checkpoint_every"])
     calls = lambda steps: max(steps // int(config["num_envs"]), 1)  # noqa: E731  (timesteps -> env steps)
     if every > 0:
-        callbacks.append(
-            CheckpointCallback(save_freq=calls(every), save_path=str(out / "checkpoints"), save_vecnormalize=True)
-        )
+        callbacks.append(CheckpointEvery(calls(every), out / "checkpoints"))
     best = None
     if config["eval_every"] > 0:
         best = BestModelCallback(
@@ -538,13 +617,20 @@ def train(
     remaining = max(timesteps - int(model.num_timesteps), 0)
     start = time.perf_counter()
     if remaining > 0:
-        model.learn(
-            total_timesteps=remaining,
-            callback=callbacks,
-            progress_bar=progress,
-            tb_log_name="ppo",
-            reset_num_timesteps=checkpoint is None,
-        )
+        try:
+            model.learn(
+                total_timesteps=remaining,
+                callback=callbacks,
+                progress_bar=progress,
+                tb_log_name="ppo",
+                reset_num_timesteps=checkpoint is None,
+            )
+        except KeyboardInterrupt:
+            # Kept up to the last whole rollout (the one being collected is lost; a resume collects it again).
+            rollout = int(config["ppo"].get("n_steps", 2048)) * int(config["num_envs"])
+            model.num_timesteps = int(model.num_timesteps) // rollout * rollout
+            saved = save_checkpoint(model, out / "checkpoints", model.num_timesteps)
+            raise TrainingInterrupted(saved, model.num_timesteps) from None
     if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):
         best.evaluate()  # the final policy competes too
     seconds = time.perf_counter() - start

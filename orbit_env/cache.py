@@ -160,7 +160,9 @@ def prune(folder: Path, keep: int = KEEP_GENERATIONS) -> list[Path]:
     A generation (``v-`` and 16 hex digits, a folder with this module's marker) goes when it is
     neither this version's, nor among the ``keep`` - 1 others used last, nor used within `IN_USE_S`.
     A flat table (the layout's before generations: one of `KINDS`, a hyphen and 24 hex digits, a
-    file, its lock, or a folder of ``.npy`` arrays) goes when not written within `FLAT_KEPT_S`.
+    file, its lock, or a folder of ``.npy`` arrays) goes when not written within `FLAT_KEPT_S`. In
+    the generations kept, what a killed write left (a ``.tmp`` file or folder) goes when not written
+    within `IN_USE_S`.
     Anything else stays, and so does what cannot be deleted (in use elsewhere, no permission).
     """
     own = f"v-{_generation()}"
@@ -185,6 +187,11 @@ def prune(folder: Path, keep: int = KEEP_GENERATIONS) -> list[Path]:
             continue
     older.sort(reverse=True)
     doomed += [entry for used, entry in older[max(keep - 1, 0) :] if now - used > IN_USE_S]
+    # What a killed write left (`store`'s temporary file or folder, ``.tmp``) in the generations kept: stale
+    # once no write has touched it within IN_USE_S (a live one is written continuously).
+    for _, entry in [(0.0, folder / own), *older[: max(keep - 1, 0)]]:
+        with contextlib.suppress(OSError):
+            doomed += [left for left in entry.glob("*.tmp") if now - left.stat().st_mtime > IN_USE_S]
     removed = []
     for entry in doomed:
         with contextlib.suppress(OSError):

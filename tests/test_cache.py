@@ -170,3 +170,25 @@ def test_a_table_that_cannot_be_deleted_does_not_cost_the_write(folder, monkeypa
     cache.store("dp", "a table beside an undeletable one", {"values": np.arange(2.0)})
     assert flat.is_file()
     assert cache.load("dp", "a table beside an undeletable one")["values"].tolist() == [0.0, 1.0]
+
+
+def test_what_a_killed_write_left_is_pruned_once_stale(folder):
+    # A DP's write killed half way left dp-....tmp (33 MB of 127) in the generation for good (a review).
+    own = cache.generation_dir()
+    other = folder / f"v-{1:016x}"  # another version's, used a minute ago: kept, and cleaned too
+    for generation in (own, other):
+        generation.mkdir()
+        (generation / ".used").touch()
+    old = time.time() - 2 * 3600.0
+    stale = [own / "dp-abc123.tmp", other / "curves-def.tmp"]
+    for path in stale:
+        path.write_bytes(b"half a table")
+        os.utime(path, (old, old))
+    stale_folder = own / "curves-0123abc.tmp"  # a mapped table's temporary folder
+    stale_folder.mkdir()
+    os.utime(stale_folder, (old, old))
+    live = own / "dp-def456.tmp"  # another process writing now: kept
+    live.write_bytes(b"being written")
+    cache.store("dp", "a table beside what a killed write left", {"values": np.arange(2.0)})
+    assert not any(path.exists() for path in [*stale, stale_folder])
+    assert live.is_file() and other.is_dir()

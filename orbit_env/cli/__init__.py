@@ -10,8 +10,11 @@ cause ends in one line on stderr and exit status 2, in the command line's words.
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
 from collections.abc import Sequence
+from typing import Any
 
 from orbit_env import cache
 from orbit_env.checks import InputError
@@ -47,6 +50,23 @@ def _in_files(error: Exception, args: object) -> str:
     return f"{where}{error.filename}: {error.strerror.lower()}"
 
 
+def _interrupt(signum: int, frame: Any) -> None:
+    """SIGTERM as Ctrl-C (see `main`)."""
+    raise KeyboardInterrupt
+
+
+def _default_in_child() -> None:
+    """A forked child dies of SIGTERM at once, as before.
+
+    A pool stops its workers so, and a Python handler would wait for the NRLMSIS call under way to return.
+    """
+    if signal.getsignal(signal.SIGTERM) is _interrupt:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+os.register_at_fork(after_in_child=_default_in_child)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     parser = build_parser()
@@ -54,6 +74,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.no_cache:
         cache.disable()
         os.environ[cache.ENV_VAR] = "off"  # and in the worker processes a batch starts
+    # SIGTERM (a session's end, ``kill``) stops a command as Ctrl-C does: workers stopped, parts and a
+    # training's checkpoint kept (only in the main thread, where signal handlers live; restored after).
+    main_thread = threading.current_thread() is threading.main_thread()
+    before = signal.signal(signal.SIGTERM, _interrupt) if main_thread else None
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
@@ -64,3 +88,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for it (a batch keeps its parts itself)
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, before)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import sys
 from typing import Any
 
@@ -12,19 +13,30 @@ from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from orbit_env.agents.train import train
+    from orbit_env.agents.train import TrainingInterrupted, train
 
-    result = train(
-        args.config,
-        args.out,
-        total_timesteps=args.timesteps,
-        seed=args.seed,
-        num_envs=args.n_envs,
-        env_id=args.env,
-        resume=args.resume,
-        force=args.force,
-        progress=not args.no_progress,
-    )
+    try:
+        result = train(
+            args.config,
+            args.out,
+            total_timesteps=args.timesteps,
+            seed=args.seed,
+            num_envs=args.n_envs,
+            env_id=args.env,
+            resume=args.resume,
+            force=args.force,
+            progress=not args.no_progress,
+        )
+    except TrainingInterrupted as stop:
+        given = [("--config", args.config), ("--timesteps", args.timesteps), ("--seed", args.seed)]
+        given += [("--n-envs", args.n_envs), ("--env", args.env), ("--out", args.out), ("--resume", stop.checkpoint)]
+        again = " ".join(f"{flag} {shlex.quote(str(value))}" for flag, value in given if value is not None)
+        print(
+            f"{PROG}: interrupted at {stop.timesteps:,} timesteps (the last whole rollout), saved in "
+            f"{stop.checkpoint}; continue with:\n  {PROG} train {again}",
+            file=sys.stderr,
+        )
+        return 130
     print(f"trained {result.trained} timesteps in {result.seconds:.0f} s ({result.timesteps} in all)")
     print(f"model: {result.model_path}  (tensorboard --logdir {result.log_dir})")
     if result.best_model_path is not None:
@@ -279,7 +291,12 @@ def add_parsers(sub: Any) -> None:
     )
     tr.add_argument("--env", metavar="ID", help="override env_id (the config's [env] keywords still apply)")
     tr.add_argument("--resume", metavar="ZIP", help="continue from a checkpoint (DIR/checkpoints/rl_model_N_steps.zip)")
-    tr.add_argument("--force", action="store_true", help="overwrite a finished run in --out (otherwise it is kept)")
+    tr.add_argument(
+        "--force",
+        action="store_true",
+        help="start over in --out, deleting a run there (finished or not: its model, checkpoints and scores); "
+        "otherwise it is kept",
+    )
     tr.add_argument("--no-progress", action="store_true", help="no progress bar")
     tr.set_defaults(func=_cmd_train)
 

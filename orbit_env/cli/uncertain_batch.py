@@ -30,6 +30,8 @@ from orbit_env.cli.orbit_inputs import records_in_reference, resolve_uncertainty
 #: file's element sets as `orbit_inputs.prepare` read them (the file's bytes are in the fingerprint).
 NOT_IN_FINGERPRINT = frozenset(
     {"out", "force", "no_progress", "workers", "address", "no_cache", "func", "batch_sets", "batch_bad_sets"}
+    # The input files' bytes are hashed, not how their paths are spelled (./a.csv is a.csv).
+    | {"batch", "solar_csv"}
 )
 
 

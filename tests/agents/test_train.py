@@ -213,8 +213,11 @@ def test_train_logs_episodes_keeps_the_best_resumes_and_keeps_a_finished_run(tmp
     assert main(["train", "--config", str(path), "--out", str(out), "--no-progress"]) == 2
     assert "exists: a finished run is kept; pass --force" in capsys.readouterr().err
     assert result.model_path.stat().st_mtime_ns == stamp
-    # Resume from the checkpoint up to a larger budget: the timesteps continue.
-    resumed = train(path, out, total_timesteps=384, resume=checkpoint, progress=False)
+    # Resume from the checkpoint up to a larger budget: the timesteps continue (it replaces the finished run,
+    # so only with force).
+    with pytest.raises(ValueError, match="would replace a finished run; pass --force"):
+        train(path, out, total_timesteps=384, resume=checkpoint, progress=False)
+    resumed = train(path, out, total_timesteps=384, resume=checkpoint, force=True, progress=False)
     assert resumed.trained == 256 and resumed.timesteps == 384
     assert PPO.load(resumed.model_path, device="cpu").num_timesteps == 384
     assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128, 256, 384]

@@ -306,3 +306,24 @@ def test_a_lost_worker_keeps_the_finished_chunks(tmp_path):
     assert not out.exists() and len(list(catalogue_parts.parts_folder(out).iterdir())) >= 4
     joined = catalogue_parts.run_in_parts(out, "0" * 16, 40, 5, DiesAt(-1), workers=2, progress=False, report=print)
     assert out.read_bytes() == whole.read_bytes() and (joined.rows, joined.ok, joined.max_days) == (40, 40, 40.0)
+
+
+def test_parts_are_resumed_whatever_the_spelling_of_the_inputs_path(capsys, tmp_path, monkeypatch):
+    # The path's text was in the fingerprint: ./sats.csv after sats.csv was "another run" (and --force would
+    # have deleted the finished parts). The file's bytes are what identify the input.
+    call = uncertain_batch.ChunkRecords.__call__
+
+    def stopped(self, start, stop):
+        if start >= 3:
+            raise KeyboardInterrupt
+        return call(self, start, stop)
+
+    monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", stopped)
+    batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 50, "--workers", 1)
+    monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", call)
+    monkeypatch.chdir(tmp_path)
+    status, stdout, err = run(
+        capsys, "lifetime", "--batch", "./sats.csv", "--out", "out.csv", "--uncertainty", "--no-progress",
+        "--samples", 50, "--workers", 1,
+    )  # fmt: skip
+    assert status == 1 and "already in" in stdout, err

@@ -1,0 +1,141 @@
+"""A training run stopped or started again loses nothing (a review of long jobs killed at any moment, 2026-12-06).
+
+Each test failed before its fix: an unfinished run's folder was trained over from zero, Ctrl-C saved nothing
+and said nothing, --resume replaced a finished model and continued under other settings, SIGTERM left no
+checkpoint.
+"""
+
+import json
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from stable_baselines3 import PPO
+from stable_baselines3.common.callbacks import BaseCallback
+
+from orbit_env.agents.train import TrainingInterrupted, newest_checkpoint, train
+from orbit_env.cli import main
+
+TINY = """\
+env_id = "OrbitRaising-v0"
+seed = 0
+num_envs = 8
+total_timesteps = 256
+checkpoint_every = 128
+eval_every = 0
+shaping = "none"
+[env]
+horizon_steps = 30
+[ppo]
+n_steps = 16
+batch_size = 64
+n_epochs = 1
+gamma = 1.0
+[policy]
+net_arch = [16]
+[normalize]
+reward = true
+"""
+
+
+class StopAt(BaseCallback):
+    """Ctrl-C at the ``calls``-th vector step (16 make a rollout of 128 timesteps here)."""
+
+    def __init__(self, calls: int) -> None:
+        super().__init__()
+        self.calls = calls
+
+    def _on_step(self) -> bool:
+        if self.n_calls == self.calls:
+            raise KeyboardInterrupt
+        return True
+
+
+@pytest.fixture
+def config(tmp_path):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY)
+    return path
+
+
+def test_an_interrupted_run_keeps_its_last_whole_rollout_and_resumes(config, tmp_path):
+    out = tmp_path / "run"
+    with pytest.raises(TrainingInterrupted) as stop:
+        train(config, out, progress=False, extra_callbacks=[StopAt(20)])  # 160 timesteps collected
+    assert stop.value.timesteps == 128 and stop.value.checkpoint == out / "checkpoints" / "rl_model_128_steps.zip"
+    assert PPO.load(stop.value.checkpoint, device="cpu").num_timesteps == 128
+    assert (out / "checkpoints" / "rl_model_vecnormalize_128_steps.pkl").is_file()
+    assert not list((out / "checkpoints" / ".partial").iterdir())  # each file moved in whole
+    # Started again as it was, the folder is refused (it had been trained over from zero) ...
+    with pytest.raises(ValueError, match=r"holds an unfinished run; continue it with --resume .*rl_model_128_steps"):
+        train(config, out, progress=False)
+    # ... resumed under other settings too, and resumed as it was, it finishes.
+    with pytest.raises(ValueError, match=r"was trained with other settings \(seed differ"):
+        train(config, out, seed=5, resume=stop.value.checkpoint, progress=False)
+    done = train(config, out, resume=stop.value.checkpoint, progress=False)
+    assert done.timesteps == 256 and done.trained == 128 and newest_checkpoint(out).name == "rl_model_256_steps.zip"
+
+
+def test_force_starts_over_without_the_old_runs_files(config, tmp_path):
+    out = tmp_path / "run"
+    train(config, out, progress=False)
+    assert newest_checkpoint(out).name == "rl_model_256_steps.zip"
+    train(config, out, total_timesteps=64, force=True, progress=False)  # one rollout: 128 timesteps
+    # The first run's checkpoint at 256 would have stood beside this one's, the newest of the folder.
+    assert sorted(p.name for p in (out / "checkpoints").glob("rl_model_*.zip")) == ["rl_model_128_steps.zip"]
+    assert PPO.load(out / "model.zip", device="cpu").num_timesteps == 128
+
+
+def test_the_command_line_says_how_to_continue(config, tmp_path, capsys, monkeypatch):
+    checkpoint = tmp_path / "run" / "checkpoints" / "rl_model_128_steps.zip"
+
+    def interrupted(*args, **kwargs):
+        raise TrainingInterrupted(checkpoint, 128)
+
+    monkeypatch.setattr("orbit_env.agents.train.train", interrupted)
+    status = main(["train", "--config", str(config), "--out", str(tmp_path / "run"), "--seed", "2", "--no-progress"])
+    assert status == 130
+    err = capsys.readouterr().err
+    assert f"interrupted at 128 timesteps (the last whole rollout), saved in {checkpoint}" in err
+    again = shlex.split(err.strip().splitlines()[-1])
+    run = str(tmp_path / "run")
+    assert again == [
+        "orbit-env",
+        "train",
+        "--config",
+        str(config),
+        "--seed",
+        "2",
+        "--out",
+        run,
+        "--resume",
+        str(checkpoint),
+    ]
+
+
+def test_sigterm_stops_training_as_ctrl_c_does(config, tmp_path):
+    # A session's end (SIGTERM) had killed the run with no checkpoint beyond the last periodic one, silently.
+    out = tmp_path / "run"
+    config.write_text(TINY.replace("total_timesteps = 256", "total_timesteps = 1000000"))
+    command = [sys.executable, "-m", "orbit_env.cli", "train", "--config", str(config), "--out", str(out)]
+    process = subprocess.Popen([*command, "--no-progress"], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while newest_checkpoint(out) is None and time.monotonic() < deadline and process.poll() is None:
+        time.sleep(0.2)
+    assert newest_checkpoint(out) is not None, "training never wrote its first checkpoint"
+    os.kill(process.pid, signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "interrupted at" in err and "--resume" in err
+    saved = Path(shlex.split(err.strip().splitlines()[-1])[-1])
+    assert PPO.load(saved, device="cpu").num_timesteps % 128 == 0  # whole rollouts, a loadable file
+    settings = json.loads((out / "config.json").read_text())
+    assert settings["total_timesteps"] == 1000000
