@@ -8,6 +8,7 @@ The seeds differ from training's (``agents/ppo.toml`` trains with seed 0).
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import inspect
 import math
@@ -315,6 +316,16 @@ def format_table(
     if paired:
         lines.append(f"paired: episode by episode on the same start states; ties within {TIE_DAYS} day")
     return "\n".join(lines)
+
+
+def write_returns(results: Mapping[str, Episodes], path: str | Path) -> None:
+    """Every episode's return [days], a row per episode and a column per policy (``episode`` first), as CSV."""
+    names = list(results)
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["episode", *names])
+        for k, values in enumerate(zip(*(results[name].returns for name in names), strict=True)):
+            writer.writerow([k, *(repr(float(v)) for v in values)])
 
 
 def plot_returns(results: Mapping[str, Episodes], env_id: str, path: str) -> None:

@@ -8,7 +8,7 @@ import shlex
 import sys
 from typing import Any
 
-from orbit_env.cli.common import PROG, check_figure, positive_int
+from orbit_env.cli.common import PROG, check_figure, check_output, positive_int
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
@@ -53,6 +53,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         format_table,
         paired_difference,
         plot_returns,
+        write_returns,
     )
 
     def say(name: str) -> None:
@@ -67,10 +68,11 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     _solar_options(args, args.env in SOLAR_ENV_IDS)
     if args.plot and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
+    if args.returns and not args.certify:
+        check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
-        given = [
-            flag for flag, value in (("--model", args.model), ("--plot", args.plot), ("--no-dp", args.no_dp)) if value
-        ]
+        flags = (("--model", args.model), ("--plot", args.plot), ("--no-dp", args.no_dp), ("--returns", args.returns))
+        given = [flag for flag, value in flags if value]
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
         return _certify(args, say)
@@ -89,6 +91,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
         plot_returns(results, args.env, args.plot)
+    if args.returns:
+        write_returns(results, args.returns)
     # The learned agent against the best hand-coded policy, then against the optimum.
     learned = next((name for name in results if name in ALGORITHMS), "ppo")
     paired = {
@@ -137,6 +141,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         plot_returns,
         policy_width,
         summarize,
+        write_returns,
     )
     from orbit_env.agents.solar import evaluate_solar, solar_report
     from orbit_env.envs import SOLAR_CONTINUOUS_ENV_ID
@@ -159,6 +164,8 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
     if args.plot:
         plot_returns(results, f"{args.env} ({args.solar_split} split)", args.plot)
+    if args.returns:
+        write_returns(results, args.returns)
     table = summarize(results)
     report = solar_report(evaluation)
     # Episode by episode: the optimum against the best operators' rule (the task's headroom), the learned
@@ -356,6 +363,11 @@ def add_parsers(sub: Any) -> None:
     )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
     ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
+    ev.add_argument(
+        "--returns",
+        metavar="CSV",
+        help="every episode's return, a column per policy (the paired differences from them, episode by episode)",
+    )
     ev.set_defaults(func=_cmd_evaluate)
 
     sw = sub.add_parser("sweep", help="algorithms x seeds as Ray Tune trials: a table of baselines with error bars")

@@ -151,3 +151,26 @@ def test_the_table_has_a_capture_column_only_with_captures_and_aligns_a_wide_spr
     captured = {name: {**values, "capture": 0.5} for name, values in table.items()}
     lines = format_table(ENV, 2, 1, captured).split("\n")
     assert lines[1].endswith("capture") and len({len(line) for line in lines[1:3]}) == 1
+
+
+def test_every_episodes_return_is_written_for_the_paired_differences(tmp_path, capsys):
+    # `--json` gave only means: a paired difference could not be recomputed, or tested otherwise, from the command.
+    import csv
+    import json
+
+    from orbit_env.cli import main
+
+    path = tmp_path / "returns.csv"
+    assert main(["evaluate", "--episodes", "30", "--no-dp", "--json", "--returns", str(path)]) == 0
+    result = json.loads(capsys.readouterr().out)
+    with open(path, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [int(row["episode"]) for row in rows] == list(range(30))
+    assert list(rows[0])[1:] == list(result["policies"])
+    pair = result["paired_difference"]
+    differences = np.array([float(row[pair["policy"]]) - float(row[pair["baseline"]]) for row in rows])
+    assert differences.mean() == pytest.approx(pair["mean"], abs=1e-9)
+    for name, summary in result["policies"].items():
+        assert np.mean([float(row[name]) for row in rows]) == pytest.approx(summary["mean_return"], abs=1e-9)
+    assert main(["evaluate", "--certify", "--returns", str(path)]) == 2  # the certificate scores no episodes
+    assert "it takes no --returns" in capsys.readouterr().err
