@@ -264,7 +264,10 @@ def _known_density_optimum(
     zero = np.zeros((episodes, plans.horizon))
     returns, burns = plans.score(np.arange(episodes), zero, policy or dp_policy(env_id, dp_lookahead, dp_rollout))
     if policy is not None:  # the search starts from the better of the policy's plan and the DP policy's
-        dp_returns, dp_burns = plans.score(np.arange(episodes), zero, dp_policy(env_id))
+        _, dp_burns = plans.score(np.arange(episodes), zero, dp_policy(env_id))
+        # The DP policy's burns as a plan, scored as the search scores plans (a burn the tank cut short is
+        # asked again as the nearest size: its replay's return, not the policy's own).
+        dp_returns = plans.score(np.arange(episodes), dp_burns)
         better = dp_returns > returns
         first = np.where(better[:, None], dp_burns, burns)
         return _Optimum(plans, returns, burns, first_plans=first, first_returns=np.where(better, dp_returns, returns))

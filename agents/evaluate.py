@@ -94,6 +94,11 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     if not hasattr(policy, "predict") and callable(policy):  # a plain function: observations -> actions
         name = getattr(policy, "__name__", type(policy).__name__)
         returned = (policy(observations), None)
+        if isinstance(returned[0], tuple):
+            raise ValueError(
+                f"{name} returned a tuple: a plain function returns the actions alone (to score a policy with "
+                "predict, pass the policy, not its predict)"
+            )
     else:
         name = type(policy).__name__
         _check_predict(policy, name, observations)
@@ -111,7 +116,7 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     if kind == "b":
         raise ValueError(f"{name}.predict returned booleans as actions; allowed: numbers of the action space")
     if kind in "OSUV":
-        raise ValueError(f"{name}.predict returned {dtype} actions; allowed: numbers of the action space")
+        raise ValueError(f"{name}.predict returned actions that are not numbers ({dtype}): {returned[0]!r:.80}")
     try:
         actions = np.asarray(returned[0], dtype=np.float64)
     except (TypeError, ValueError):

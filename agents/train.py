@@ -364,10 +364,7 @@ class BestModelCallback(BaseCallback):
         self.save_dir.mkdir(parents=True, exist_ok=True)
         if mean > self.best_mean:
             self.best_mean = mean
-            partial = self.save_dir / ".partial"
-            partial.mkdir(exist_ok=True)
-            self.model.save(partial / self.best_model_path.name, exclude=["env", "tensorboard_log"])
-            (partial / self.best_model_path.name).replace(self.best_model_path)  # whole or not at all
+            _save_whole(self.model, self.best_model_path)
         self.logger.record("eval/best_mean_reward", self.best_mean)
         self.evaluations.append({"timesteps": int(self.model.num_timesteps), "mean_return": mean})
         written = self.save_dir / "evaluations.json.partial"
@@ -446,6 +443,17 @@ class TrainingInterrupted(KeyboardInterrupt):
         self.checkpoint = checkpoint
         self.timesteps = timesteps
 
+    def __reduce__(self) -> tuple[Any, ...]:  # raised in a worker process, it reaches the parent whole
+        return TrainingInterrupted, (self.checkpoint, self.timesteps)
+
+
+def _save_whole(model: Any, path: Path) -> None:
+    """``model.save(path)``, written aside and moved in (a rename: the file is whole or absent)."""
+    partial = path.parent / ".partial"
+    partial.mkdir(parents=True, exist_ok=True)
+    model.save(partial / path.name, exclude=["env", "tensorboard_log"])
+    (partial / path.name).replace(path)
+
 
 def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
     """``rl_model_N_steps.zip`` (N = ``timesteps``) and its reward statistics, each written whole or not at all.
@@ -461,8 +469,7 @@ def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
     if normalize is not None:
         normalize.save(str(partial / _vecnormalize_path(path).name))
         (partial / _vecnormalize_path(path).name).replace(_vecnormalize_path(path))
-    model.save(partial / path.name, exclude=["env", "tensorboard_log"])
-    (partial / path.name).replace(path)
+    _save_whole(model, path)
     return path
 
 
@@ -537,6 +544,7 @@ def train(
     try:
         import torch
         from stable_baselines3 import PPO
+        from stable_baselines3.common.callbacks import ProgressBarCallback
         from stable_baselines3.common.vec_env import VecNormalize
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
@@ -550,12 +558,26 @@ def train(
         if value is not None:
             config[key] = value
     _check_values(config, source)
-    timesteps = timesteps_to_train(config["total_timesteps"], config)
     out = Path(out_dir)
     model_path = out / "model.zip"
     checkpoint = None if resume is None else Path(resume)
     if checkpoint is not None and not checkpoint.is_file():
         raise ValueError(f"no checkpoint at {checkpoint}")
+    # A resume continues the checkpoint's run (its folder's settings, whatever --out is), up to its budget
+    # unless --timesteps gives another.
+    started_path = None if checkpoint is None else checkpoint.parent.parent / "config.json"
+    if started_path is not None and started_path.is_file():
+        started = json.loads(started_path.read_text())
+        if total_timesteps is None:
+            config["total_timesteps"] = started["total_timesteps"]
+        changed = sorted(key for key in {*started, *config} if started.get(key) != config.get(key))
+        changed = [key for key in changed if key != "total_timesteps"]
+        if changed:
+            raise ValueError(
+                f"{checkpoint} is of a run trained with other settings ({', '.join(changed)} differ from "
+                f"{started_path}): give the run's --config and options to resume it (--timesteps may change)"
+            )
+    timesteps = timesteps_to_train(config["total_timesteps"], config)
     if model_path.exists() and not force:
         if checkpoint is None:
             raise ValueError(f"{model_path} exists: a finished run is kept; pass --force to overwrite it")
@@ -567,19 +589,9 @@ def train(
     if force and checkpoint is None:  # a new run: the old one's files would mix with its own
         for old in [*Path(out, "checkpoints").glob("rl_model_*"), *(out / name for name in _RUN_FILES)]:
             old.unlink(missing_ok=True)
-    settings = out / "config.json"  # the run's settings, so that a resume continues the same run
-    if checkpoint is not None and settings.is_file():
-        started = json.loads(settings.read_text())
-        changed = sorted(
-            key for key in {*started, *config} if key != "total_timesteps" and started.get(key) != config.get(key)
-        )
-        if changed:
-            raise ValueError(
-                f"{out} was trained with other settings ({', '.join(changed)} differ from {settings}): give the "
-                "run's --config and options to resume it (--timesteps may change)"
-            )
     out.mkdir(parents=True, exist_ok=True)
-    settings.write_text(json.dumps(config, indent=1, sort_keys=True) + "\n")
+    # The run's settings, so that a resume continues the same run.
+    (out / "config.json").write_text(json.dumps(config, indent=1, sort_keys=True) + "\n")
     torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
     seed = int(config["seed"])
     venv: Any = training_env(config)
@@ -615,26 +627,31 @@ def train(
         callbacks.append(best)
     callbacks.extend(extra_callbacks)
     remaining = max(timesteps - int(model.num_timesteps), 0)
+    # The bar is this function's own, so that an interrupt can close it: a live rich bar would wrap (and
+    # redraw around) the lines printed after it.
+    bar = ProgressBarCallback() if progress and remaining > 0 else None
     start = time.perf_counter()
-    if remaining > 0:
-        try:
+    try:
+        if remaining > 0:
             model.learn(
                 total_timesteps=remaining,
-                callback=callbacks,
-                progress_bar=progress,
+                callback=[*callbacks, *([bar] if bar is not None else [])],
                 tb_log_name="ppo",
                 reset_num_timesteps=checkpoint is None,
             )
-        except KeyboardInterrupt:
-            # Kept up to the last whole rollout (the one being collected is lost; a resume collects it again).
-            rollout = int(config["ppo"].get("n_steps", 2048)) * int(config["num_envs"])
-            model.num_timesteps = int(model.num_timesteps) // rollout * rollout
-            saved = save_checkpoint(model, out / "checkpoints", model.num_timesteps)
-            raise TrainingInterrupted(saved, model.num_timesteps) from None
-    if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):
-        best.evaluate()  # the final policy competes too
-    seconds = time.perf_counter() - start
-    model.save(model_path, exclude=["env", "tensorboard_log"])
+        if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):
+            best.evaluate()  # the final policy competes too
+        seconds = time.perf_counter() - start
+        _save_whole(model, model_path)
+    except KeyboardInterrupt:
+        if bar is not None and getattr(bar, "pbar", None) is not None:
+            bar.pbar.close()
+        # Kept up to the last whole rollout: one being collected is collected again on resuming; an update
+        # stopped part way keeps the epochs it finished.
+        rollout = int(config["ppo"].get("n_steps", 2048)) * int(config["num_envs"])
+        model.num_timesteps = int(model.num_timesteps) // rollout * rollout
+        saved = save_checkpoint(model, out / "checkpoints", model.num_timesteps)
+        raise TrainingInterrupted(saved, model.num_timesteps) from None
     return TrainResult(
         model_path=model_path,
         log_dir=out / "tensorboard",

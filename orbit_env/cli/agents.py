@@ -6,6 +6,7 @@ import argparse
 import json
 import shlex
 import sys
+from pathlib import Path
 from typing import Any
 
 from orbit_env.cli.common import PROG, check_figure, check_output, positive_int
@@ -31,6 +32,8 @@ def _cmd_train(args: argparse.Namespace) -> int:
         given = [("--config", args.config), ("--timesteps", args.timesteps), ("--seed", args.seed)]
         given += [("--n-envs", args.n_envs), ("--env", args.env), ("--out", args.out), ("--resume", stop.checkpoint)]
         again = " ".join(f"{flag} {shlex.quote(str(value))}" for flag, value in given if value is not None)
+        if Path(args.out, "model.zip").exists():  # an interrupted resume of a finished run replaces it again
+            again += " --force"
         print(
             f"{PROG}: interrupted at {stop.timesteps:,} timesteps (the last whole rollout), saved in "
             f"{stop.checkpoint}; continue with:\n  {PROG} train {again}",

@@ -105,7 +105,7 @@ def test_predict_without_deterministic_and_non_numeric_actions_are_named():
             return np.array(["0"] * len(obs)), state
 
     # '0' converted to 0.0 and was reported as "<U1 actions for a discrete space (0.0 first)".
-    with pytest.raises(ValueError, match=r"Text\.predict returned <U1 actions; allowed: numbers"):
+    with pytest.raises(ValueError, match=r"Text\.predict returned actions that are not numbers \(<U1\)"):
         predicted_actions(Text(), OBS, gym.spaces.Discrete(4))
 
 

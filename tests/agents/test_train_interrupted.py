@@ -78,7 +78,7 @@ def test_an_interrupted_run_keeps_its_last_whole_rollout_and_resumes(config, tmp
     with pytest.raises(ValueError, match=r"holds an unfinished run; continue it with --resume .*rl_model_128_steps"):
         train(config, out, progress=False)
     # ... resumed under other settings too, and resumed as it was, it finishes.
-    with pytest.raises(ValueError, match=r"was trained with other settings \(seed differ"):
+    with pytest.raises(ValueError, match=r"is of a run trained with other settings \(seed differ"):
         train(config, out, seed=5, resume=stop.value.checkpoint, progress=False)
     done = train(config, out, resume=stop.value.checkpoint, progress=False)
     assert done.timesteps == 256 and done.trained == 128 and newest_checkpoint(out).name == "rl_model_256_steps.zip"
@@ -119,6 +119,11 @@ def test_the_command_line_says_how_to_continue(config, tmp_path, capsys, monkeyp
         "--resume",
         str(checkpoint),
     ]
+    # A finished run's resume, interrupted: continuing it replaces the model again, so the command says --force.
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "model.zip").write_bytes(b"a finished run's model")
+    assert main(["train", "--out", run, "--resume", str(checkpoint), "--force", "--no-progress"]) == 130
+    assert shlex.split(capsys.readouterr().err.strip().splitlines()[-1])[-1] == "--force"
 
 
 def test_sigterm_stops_training_as_ctrl_c_does(config, tmp_path):
@@ -127,15 +132,53 @@ def test_sigterm_stops_training_as_ctrl_c_does(config, tmp_path):
     config.write_text(TINY.replace("total_timesteps = 256", "total_timesteps = 1000000"))
     command = [sys.executable, "-m", "orbit_env.cli", "train", "--config", str(config), "--out", str(out)]
     process = subprocess.Popen([*command, "--no-progress"], stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while newest_checkpoint(out) is None and time.monotonic() < deadline and process.poll() is None:
-        time.sleep(0.2)
-    assert newest_checkpoint(out) is not None, "training never wrote its first checkpoint"
-    os.kill(process.pid, signal.SIGTERM)
-    _, err = process.communicate(timeout=60)
+    try:
+        deadline = time.monotonic() + 120
+        while newest_checkpoint(out) is None and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.2)
+        assert newest_checkpoint(out) is not None, "training never wrote its first checkpoint"
+        os.kill(process.pid, signal.SIGTERM)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:  # a failed test leaves no run training towards a million steps
+            process.kill()
+            process.wait()
     assert process.returncode == 130, err
     assert "interrupted at" in err and "--resume" in err
     saved = Path(shlex.split(err.strip().splitlines()[-1])[-1])
     assert PPO.load(saved, device="cpu").num_timesteps % 128 == 0  # whole rollouts, a loadable file
     settings = json.loads((out / "config.json").read_text())
     assert settings["total_timesteps"] == 1000000
+
+
+def test_a_resume_continues_its_runs_budget_and_settings_whatever_out_is(config, tmp_path):
+    # A plain --resume had trained on to the TOML's budget (256 here) instead of the run's (--timesteps 384), and
+    # the settings were those of --out's folder, not of the checkpoint's run.
+    out = tmp_path / "run"
+    with pytest.raises(TrainingInterrupted) as stop:
+        train(config, out, total_timesteps=384, progress=False, extra_callbacks=[StopAt(20)])
+    with pytest.raises(ValueError, match=r"is of a run trained with other settings \(seed differ"):
+        train(config, tmp_path / "elsewhere", seed=5, resume=stop.value.checkpoint, progress=False)
+    done = train(config, out, resume=stop.value.checkpoint, progress=False)
+    assert done.timesteps == 384
+
+
+def test_an_interrupt_while_the_model_is_written_leaves_a_checkpoint_not_half_a_model(config, tmp_path, monkeypatch):
+    import orbit_env.agents.train as train_module
+
+    written = train_module._save_whole
+
+    def interrupted(model, path):
+        if path.name == "model.zip":
+            raise KeyboardInterrupt
+        written(model, path)
+
+    monkeypatch.setattr(train_module, "_save_whole", interrupted)
+    out = tmp_path / "run"
+    with pytest.raises(TrainingInterrupted) as stop:
+        train(config, out, progress=False)
+    assert stop.value.timesteps == 256 and not (out / "model.zip").exists()
+    import pickle  # raised in a worker process (curves, sweeps), it reaches the parent whole
+
+    again = pickle.loads(pickle.dumps(stop.value))
+    assert (again.checkpoint, again.timesteps) == (stop.value.checkpoint, 256)
