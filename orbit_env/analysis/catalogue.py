@@ -18,7 +18,7 @@ group.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -167,11 +167,13 @@ def _stepped_spread(
     rule_years: float | None,
     cap_days: float | None,
     outputs: tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_], FloatArray, FloatArray],
+    bar: Any = None,
 ) -> float:
     """Lifetimes (and the rule) of ``members`` on the time-stepped path, one family; returns its inclination.
 
     The family is that of the most common inclination group; every row keeps its own
-    inclination as a density multiplier (`orbit_env.decay.chunked.propagate`).
+    inclination as a density multiplier (`orbit_env.decay.chunked.propagate`). ``bar`` (tqdm)
+    counts the satellites as they re-enter, and all of them at the end.
     """
     perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg = inputs
     days, reentered = outputs[:2]
@@ -179,7 +181,12 @@ def _stepped_spread(
     c, own = drag_parameter_m2_kg[members], inclination_deg[members]
     if rule_years is None:
         days[members], reentered[members] = scenario.lifetime_days(
-            perigee_m[members], apogee_m[members], c, reference, own_inclination_deg=own
+            perigee_m[members],
+            apogee_m[members],
+            c,
+            reference,
+            own_inclination_deg=own,
+            progress=None if bar is None else _counting(bar, members.size),
         )
         return reference
 
@@ -188,6 +195,16 @@ def _stepped_spread(
 
     _store_check(outputs, members, check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes))
     return reference
+
+
+def _counting(bar: Any, size: int) -> Callable[[float], None]:
+    """A `propagate` progress callback: ``bar`` (tqdm) moves by the share of ``size`` satellites re-entered."""
+    start = bar.n
+
+    def reentering(fraction: float) -> None:
+        bar.update(start + int(fraction * size) - bar.n)
+
+    return reentering
 
 
 def _store_check(
@@ -270,8 +287,9 @@ def batch_lifetimes(
         if one_family:
             members = np.flatnonzero(ok)
             if scenario.time_varying:
-                families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs))
-                bar.update(members.size)
+                start = bar.n
+                families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs, bar))
+                bar.update(start + members.size - bar.n)
             elif rule_years is None:
                 families.add(_spread_batch(scenario, members, group_of, inputs, days, reentered, bar))
             else:  # the rule's search for the lowered perigee on the same family
@@ -287,9 +305,11 @@ def batch_lifetimes(
             inclination = float(group) if depends_on_inclination else float(inclination_deg[members[0]])
             blocks = [members] if scenario.time_varying else np.array_split(members, max(1, members.size // BLOCK))
             for block in blocks:
+                start = bar.n
                 if rule_years is None:
+                    moving = _counting(bar, block.size) if scenario.time_varying else None
                     d, r = scenario.lifetime_days(
-                        perigee_m[block], apogee_m[block], drag_parameter_m2_kg[block], inclination
+                        perigee_m[block], apogee_m[block], drag_parameter_m2_kg[block], inclination, progress=moving
                     )
                     days[block], reentered[block] = d, r
                 else:
@@ -301,7 +321,7 @@ def batch_lifetimes(
                     _store_check(
                         outputs, block, check_disposal_rule(perigee_m[block], apogee_m[block], rule_years, lifetimes)
                     )
-                bar.update(block.size)
+                bar.update(start + block.size - bar.n)
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:
             status[i] = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"

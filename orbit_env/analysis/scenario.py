@@ -7,6 +7,7 @@ when the air follows a date, the chunked curves of `orbit_env.decay.chunked`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -180,13 +181,15 @@ class Scenario:
         density_scale: ArrayLike = 1.0,
         max_days: float | None = None,
         own_inclination_deg: ArrayLike | None = None,
+        progress: Callable[[float], None] | None = None,
     ) -> tuple[FloatArray, NDArray[np.bool_]]:
         """Days to re-entry of many satellites (one inclination), and whether they re-enter.
 
         Fixed profiles: one lookup on the universal curves. Time-varying: the
         chunked curves, stopped after ``max_days`` if given (else ``max_years``);
         with ``own_inclination_deg``, each satellite's inclination on the curves of
-        ``inclination_deg`` (`orbit_env.decay.chunked.propagate`).
+        ``inclination_deg`` (`orbit_env.decay.chunked.propagate`), and ``progress``
+        called with the share of them re-entered after each chunk.
 
         Raises:
             ValueError: heights invalid or outside the universal curves' domain, a drag parameter or
@@ -208,5 +211,7 @@ class Scenario:
             inclination_deg, None if max_days is None else max(max_days, self.chunk_days) / DAYS_PER_YEAR
         )
         own = None if own_inclination_deg is None else np.broadcast_to(own_inclination_deg, hp.shape).ravel()
-        result = propagate(hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel(), inclination_deg=own)
+        result = propagate(
+            hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel(), inclination_deg=own, progress=progress
+        )
         return result.days.reshape(hp.shape), result.reentered.reshape(hp.shape)

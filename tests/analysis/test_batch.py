@@ -237,3 +237,38 @@ def test_batch_in_many_blocks_keeps_the_input_order(capsys, tmp_path, monkeypatc
         expected = lifetime(float(row["perigee_km"]), float(row["apogee_km"]), satellite=satellite, method="curves")
         # 1e-5: the CSV's six significant digits.
         assert float(record["days"]) == pytest.approx(expected.days, rel=1e-5)
+
+
+def test_a_dated_batch_counts_its_satellites_as_they_re_enter(capsys, tmp_path, monkeypatch):
+    # The bar stood at 0 for the whole propagation of a dated batch (3 minutes for 2000 rows), then jumped to
+    # the end: it moves now after each chunk, by the satellites re-entered.
+    pytest.importorskip("pymsis")
+    positions = []
+
+    class Recorded:
+        def __init__(self, total, **kwargs):
+            self.n, self.total = 0, total
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def update(self, k):
+            self.n += k
+            positions.append(self.n)
+
+    monkeypatch.setattr("tqdm.tqdm", Recorded)
+    flux = tmp_path / "flux.csv"
+    flux.write_text("date,f107\n" + "\n".join(f"2024-{m:02d},160" for m in range(1, 13)) + "\n2025-01,150\n")
+    sats = tmp_path / "sats.csv"
+    heights = np.linspace(250.0, 380.0, 12)  # lives of weeks to months: re-entries in many 20-day chunks
+    sats.write_text("perigee_km,apogee_km,mass_kg,area_m2,cx\n" + "".join(f"{h},{h},400,1,2.2\n" for h in heights))
+    status, stdout, _ = run(
+        capsys, "lifetime", "--batch", str(sats), "--out", str(tmp_path / "out.csv"), "--atmosphere", "msis",
+        "--solar-csv", str(flux), "--inclination", "51.6",
+    )  # fmt: skip
+    assert status == 0, stdout
+    assert positions[-1] == 12 and positions == sorted(positions)
+    assert len(set(positions)) >= 4  # several chunks' re-entries counted before the end
