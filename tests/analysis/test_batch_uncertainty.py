@@ -173,8 +173,8 @@ def test_resumed_run_ends_with_the_same_file(capsys, tmp_path, monkeypatch):
     assert not catalogue_parts.parts_folder(out).exists()
 
 
-def test_parts_of_another_command_are_refused_or_replaced(capsys, tmp_path, monkeypatch):
-    _, _, _, fresh = batch(capsys, tmp_path, SATELLITES, "sats.csv", "fresh.csv", "--samples", 60, "--workers", 1)
+def stopped_at_the_fourth_chunk(capsys, tmp_path, monkeypatch):
+    """``sats.csv`` to ``out.csv`` with 50 samples, interrupted (Ctrl-C) at its fourth chunk: three parts kept."""
     call = uncertain_batch.ChunkRecords.__call__
 
     def stopped(self, start, stop):
@@ -185,6 +185,11 @@ def test_parts_of_another_command_are_refused_or_replaced(capsys, tmp_path, monk
     monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", stopped)
     batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 50, "--workers", 1)
     monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", call)
+
+
+def test_parts_of_another_command_are_refused_or_replaced(capsys, tmp_path, monkeypatch):
+    _, _, _, fresh = batch(capsys, tmp_path, SATELLITES, "sats.csv", "fresh.csv", "--samples", 60, "--workers", 1)
+    stopped_at_the_fourth_chunk(capsys, tmp_path, monkeypatch)
     status, stdout, err, out = batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 60)
     assert status == 2 and "holds the parts of another run" in err and not out.exists()
     assert "workers:" not in stdout  # the refusal comes alone, not after a line about a run that does not start
@@ -311,16 +316,7 @@ def test_a_lost_worker_keeps_the_finished_chunks(tmp_path):
 def test_parts_are_resumed_whatever_the_spelling_of_the_inputs_path(capsys, tmp_path, monkeypatch):
     # The path's text was in the fingerprint: ./sats.csv after sats.csv was "another run" (and --force would
     # have deleted the finished parts). The file's bytes are what identify the input.
-    call = uncertain_batch.ChunkRecords.__call__
-
-    def stopped(self, start, stop):
-        if start >= 3:
-            raise KeyboardInterrupt
-        return call(self, start, stop)
-
-    monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", stopped)
-    batch(capsys, tmp_path, SATELLITES, "sats.csv", "out.csv", "--samples", 50, "--workers", 1)
-    monkeypatch.setattr(uncertain_batch.ChunkRecords, "__call__", call)
+    stopped_at_the_fourth_chunk(capsys, tmp_path, monkeypatch)
     monkeypatch.chdir(tmp_path)
     status, stdout, err = run(
         capsys, "lifetime", "--batch", "./sats.csv", "--out", "out.csv", "--uncertainty", "--no-progress",
