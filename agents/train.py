@@ -545,6 +545,7 @@ def train(
         import torch
         from stable_baselines3 import PPO
         from stable_baselines3.common.callbacks import ProgressBarCallback
+        from stable_baselines3.common.logger import configure as configure_logger
         from stable_baselines3.common.vec_env import VecNormalize
     except ImportError as error:  # pragma: no cover - depends on the installation
         raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
@@ -563,11 +564,19 @@ def train(
     checkpoint = None if resume is None else Path(resume)
     if checkpoint is not None and not checkpoint.is_file():
         raise ValueError(f"no checkpoint at {checkpoint}")
-    # A resume continues the checkpoint's run (its folder's settings, whatever --out is), up to its budget
-    # unless --timesteps gives another.
-    started_path = None if checkpoint is None else checkpoint.parent.parent / "config.json"
+    # A resume continues the checkpoint's run (the settings of the run folder its checkpoints/ is in, else of
+    # --out's), up to its budget unless --timesteps gives another.
+    started_path = None
+    if checkpoint is not None:
+        folder = checkpoint.resolve().parent
+        started_path = (folder.parent if folder.name == "checkpoints" else out) / "config.json"
     if started_path is not None and started_path.is_file():
-        started = json.loads(started_path.read_text())
+        try:
+            started = json.loads(started_path.read_text())
+        except json.JSONDecodeError:
+            started = None
+        if not (isinstance(started, dict) and "total_timesteps" in started):
+            raise ValueError(f"{started_path} is not a training run's settings (orbit-env train writes them)")
         if total_timesteps is None:
             config["total_timesteps"] = started["total_timesteps"]
         changed = sorted(key for key in {*started, *config} if started.get(key) != config.get(key))
@@ -640,6 +649,9 @@ def train(
                 reset_num_timesteps=checkpoint is None,
             )
         if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):
+            if remaining == 0:  # resumed at its budget (stopped in its final evaluation): learn set up nothing
+                model.set_logger(configure_logger(None, []))
+                best.init_callback(model)
             best.evaluate()  # the final policy competes too
         seconds = time.perf_counter() - start
         _save_whole(model, model_path)

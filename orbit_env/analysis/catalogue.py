@@ -18,6 +18,7 @@ group.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -242,6 +243,7 @@ def batch_lifetimes(
     progress: bool = True,
     exact_groups: bool = False,
     epoch_days: FloatArray | None = None,
+    bar: Any = None,
 ) -> tuple[list[dict[str, Any]], BatchSummary]:
     """Lifetimes (and the rule check) of every valid row; output records in input order.
 
@@ -250,6 +252,7 @@ def batch_lifetimes(
     ``epoch_days`` (a dated ``scenario`` only): each row's own start [unix days], the
     epoch of its object's latest element set; the rows of each date run in the scenario
     moved to it (`Scenario.at_epoch`), and the records gain ``epoch`` and ``reentry_date``.
+    ``bar``: a progress bar (tqdm) to move instead of one of its own (``progress`` is then unused).
     """
     if epoch_days is not None:
         return _from_own_epochs(
@@ -283,7 +286,8 @@ def batch_lifetimes(
     outputs = (days, reentered, complies, new_hp, dv)
     from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
 
-    with tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
+    own = tqdm(total=int(ok.sum()), disable=not progress, unit="sat", desc="lifetimes") if bar is None else None
+    with own if own is not None else contextlib.nullcontext(bar) as bar:
         if one_family:
             members = np.flatnonzero(ok)
             if scenario.time_varying:
@@ -391,12 +395,13 @@ def _from_own_epochs(
         # Rows with no lifetime to compute go with the first date: their records say why.
         for k, date in enumerate(dates if dates.size else [np.nan]):
             members = np.flatnonzero((valid & (epoch_days == date)) | (~valid & (k == 0)))
+            start = bar.n
             part, summary = batch_lifetimes(
                 [rows[i] for i in members],
                 *(x[members] for x in inputs),
                 [status[i] for i in members],
                 scenario if np.isnan(date) else scenario.at_epoch(float(date)),
-                progress=False,
+                bar=bar,  # moved by the date's satellites as they re-enter
                 **options,
             )
             groups += summary.groups
@@ -406,5 +411,5 @@ def _from_own_epochs(
                 record_date["reentry_date"] = iso_datetime(float(epoch_days[i]) + float(days)) if days else ""
                 status[i] = record.pop("status")
                 records[i] = {**record, **record_date, "status": status[i]}
-            bar.update(int(valid[members].sum()))
+            bar.update(start + int(valid[members].sum()) - bar.n)
     return records, BatchSummary(rows=len(rows), ok=sum(s == "ok" for s in status), groups=groups)

@@ -182,3 +182,45 @@ def test_an_interrupt_while_the_model_is_written_leaves_a_checkpoint_not_half_a_
 
     again = pickle.loads(pickle.dumps(stop.value))
     assert (again.checkpoint, again.timesteps) == (stop.value.checkpoint, 256)
+
+
+def test_a_run_stopped_in_its_final_evaluation_resumes_to_that_evaluation(config, tmp_path, monkeypatch):
+    # The checkpoint at the budget resumed with nothing to train: the final evaluation then ran on a callback
+    # learn had never set up (AttributeError: no attribute 'model'), so the printed command failed.
+    import orbit_env.agents.train as train_module
+
+    config.write_text(TINY.replace("eval_every = 0", "eval_every = 128\neval_episodes = 4"))
+    scored = train_module.BestModelCallback.evaluate
+
+    def stopped_at_the_end(self):
+        if self.model.num_timesteps == 256:
+            raise KeyboardInterrupt
+        return scored(self)
+
+    monkeypatch.setattr(train_module.BestModelCallback, "evaluate", stopped_at_the_end)
+    out = tmp_path / "run"
+    with pytest.raises(TrainingInterrupted) as stop:
+        train(config, out, progress=False)
+    monkeypatch.setattr(train_module.BestModelCallback, "evaluate", scored)
+    done = train(config, out, resume=stop.value.checkpoint, progress=False)
+    assert done.trained == 0 and done.timesteps == 256
+    assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128, 256]
+
+
+def test_the_settings_a_resume_checks_are_its_runs_wherever_the_checkpoint_file_is(config, tmp_path):
+    # A checkpoint copied out of checkpoints/ had escaped the check (and overwritten the run's config.json); a
+    # config.json two folders up that was no run's had crashed the command with a KeyError.
+    out = tmp_path / "run"
+    train(config, out, total_timesteps=128, progress=False)
+    elsewhere = tmp_path / "copies" / "sub"
+    elsewhere.mkdir(parents=True)
+    copy = elsewhere / "rl_model_128_steps.zip"
+    copy.write_bytes((out / "checkpoints" / "rl_model_128_steps.zip").read_bytes())
+    with pytest.raises(ValueError, match=r"other settings \(num_envs, seed differ"):
+        train(config, out, seed=5, num_envs=4, resume=copy, force=True, progress=False)
+    (tmp_path / "copies" / "checkpoints").mkdir()
+    (tmp_path / "copies" / "config.json").write_text('{"name": "not a run"}')
+    inside = tmp_path / "copies" / "checkpoints" / copy.name
+    inside.write_bytes(copy.read_bytes())
+    with pytest.raises(ValueError, match="is not a training run's settings"):
+        train(config, tmp_path / "other", resume=inside, progress=False)
