@@ -12,6 +12,7 @@ import csv
 import dataclasses
 import inspect
 import math
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -184,6 +185,7 @@ def run_episodes(
     running = np.ones(episodes, dtype=bool)
     actions = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
     oracle = policy if isinstance(policy, OracleDP) else None  # reads the hidden state it is told; no one else
+    first = True
     try:
         while running.any():
             # Only the first episode of each satellite is scored: the policy acts on the
@@ -193,6 +195,16 @@ def run_episodes(
                 oracle.bind(env, rows)
             actions[...] = 0
             actions[rows] = predicted_actions(policy, obs[rows], env.single_action_space)
+            if first:  # the same observations asked again: a policy that answers otherwise is not reproducible
+                first = False
+                if not np.array_equal(predicted_actions(policy, obs[rows], env.single_action_space), actions[rows]):
+                    name = getattr(policy, "__name__", type(policy).__name__)
+                    warnings.warn(
+                        f"{name} acts otherwise on the same observations (deterministic=True asked): its scores "
+                        "change from run to run, and a paired difference against it is not reproducible",
+                        UserWarning,
+                        stacklevel=2,
+                    )
             obs, reward, terminated, truncated, info = env.step(actions)
             burn = np.asarray(info["burn_m_s"], dtype=np.float64)
             returns += np.where(running, reward, 0.0)
@@ -514,23 +526,28 @@ def all_policies(
     warn: Callable[[str], None] | None = None,
     dp_lookahead: int = 1,
     dp_rollout: bool = False,
+    learned_name: str | None = None,
 ) -> dict[str, Predictor]:
     """Hand-coded baselines, the DP optimum (if asked) and the learned agent, in `policy_order`.
 
     The learned agent (``model_path``, or the shipped one) is loaded and checked
     first (`load_model`), before the DP's solve; its row is named by its
-    algorithm (``ppo``, ``a2c``, ...). ``dp_lookahead``, ``dp_rollout``: the DP
-    policy's (`dp_policy`).
+    algorithm (``ppo``, ``a2c``, ...), or ``learned_name`` (listed last; not a
+    baseline's or the DP's name). ``dp_lookahead``, ``dp_rollout``: the DP policy's (`dp_policy`).
     """
+    if learned_name is not None and learned_name in (*HAND_CODED, "dp"):
+        raise ValueError(f"the learned agent's row may not be named {learned_name!r}: a baseline's or the DP's row")
     learned = load_model(env_id, model_path, warn)
     policies = hand_coded_policies(env_id)
     if include_dp:
         if progress is not None:
             progress("dp (solved on the first run, then read from the disk cache)")
         policies["dp"] = dp_policy(env_id, dp_lookahead, dp_rollout)
+    name = None if learned is None else learned_name or learned[0]
     if learned is not None:
-        policies[learned[0]] = learned[1]
-    return {name: policies[name] for name in policy_order() if name in policies}
+        policies[name] = learned[1]
+    order = [*policy_order(), *([name] if name is not None and name not in policy_order() else [])]
+    return {key: policies[key] for key in order if key in policies}
 
 
 class ContinuousFromDiscrete:

@@ -75,6 +75,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
         flags = (("--model", args.model), ("--plot", args.plot), ("--no-dp", args.no_dp), ("--returns", args.returns))
+        flags += (("--name", args.name),)
         given = [flag for flag, value in flags if value]
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
@@ -90,6 +91,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         warn=warn,
         dp_lookahead=args.dp_lookahead,
         dp_rollout=args.dp_rollout,
+        learned_name=args.name,
     )
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot:
@@ -97,7 +99,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     if args.returns:
         write_returns(results, args.returns)
     # The learned agent against the best hand-coded policy, then against the optimum.
-    learned = next((name for name in results if name in ALGORITHMS), "ppo")
+    learned = args.name or next((name for name in results if name in ALGORITHMS), "ppo")
     paired = {
         "paired_difference": paired_difference(results, name=learned),
         "paired_to_dp": paired_difference(results, name=learned, baseline="dp"),
@@ -151,7 +153,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
 
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
     loaded = load_model(args.env, args.model, warn=lambda text: print(f"{PROG}: warning: {text}", file=sys.stderr))
-    learned = {} if loaded is None else {loaded[0]: loaded[1]}
+    learned = {} if loaded is None else {args.name or loaded[0]: loaded[1]}
     evaluation = evaluate_solar(
         args.episodes,
         args.seed,
@@ -325,6 +327,12 @@ def add_parsers(sub: Any) -> None:
         metavar="ZIP",
         help="a Stable-Baselines3 model (PPO, A2C, DQN, SAC, TD3; default: the shipped PPO of the environment); "
         "a policy of your own in Python: docs/how-to/score-a-policy.md",
+    )
+    ev.add_argument(
+        "--name",
+        metavar="ROW",
+        help="the learned agent's row (default: its algorithm, ppo, a2c, ...): two models of one algorithm "
+        "side by side, each run under its own name",
     )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
     ev.add_argument(

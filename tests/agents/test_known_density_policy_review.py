@@ -174,3 +174,28 @@ def test_every_episodes_return_is_written_for_the_paired_differences(tmp_path, c
         assert np.mean([float(row[name]) for row in rows]) == pytest.approx(summary["mean_return"], abs=1e-9)
     assert main(["evaluate", "--certify", "--returns", str(path)]) == 2  # the certificate scores no episodes
     assert "it takes no --returns" in capsys.readouterr().err
+
+
+def test_the_learned_row_takes_the_name_given(capsys):
+    # --model mine.zip was always the `ppo` row (by its algorithm): two PPO models could not be told apart.
+    import json
+
+    from orbit_env.cli import main
+
+    assert main(["evaluate", "--episodes", "10", "--no-dp", "--json", "--name", "mine"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert list(result["policies"])[-1] == "mine" and "ppo" not in result["policies"]
+    assert result["paired_difference"]["policy"] == "mine"
+    assert main(["evaluate", "--episodes", "10", "--no-dp", "--name", "never"]) == 2
+    assert "may not be named 'never'" in capsys.readouterr().err
+
+
+def test_a_policy_that_acts_otherwise_on_the_same_observations_is_flagged():
+    # A random policy scored 249.44 and 249.98 in two runs, without a word.
+    rng = np.random.default_rng(0)
+
+    def coin(obs):
+        return rng.integers(0, 2, len(obs))
+
+    with pytest.warns(UserWarning, match="coin acts otherwise on the same observations"):
+        run_episodes(ENV, coin, 40, 1)
