@@ -11,6 +11,7 @@ output with the default file::
 from __future__ import annotations
 
 import json
+import re
 import time
 import tomllib
 from collections.abc import Callable, Sequence
@@ -488,8 +489,15 @@ class CheckpointEvery(BaseCallback):
 
 
 def newest_checkpoint(out_dir: str | Path) -> Path | None:
-    """The checkpoint of most timesteps in ``out_dir/checkpoints``, or None."""
-    found = [(int(p.stem.split("_")[2]), p) for p in Path(out_dir, "checkpoints").glob("rl_model_*_steps.zip")]
+    """The checkpoint of most timesteps in ``out_dir/checkpoints`` (``rl_model_N_steps.zip``), or None."""
+    folder = Path(out_dir, "checkpoints")
+    if not folder.is_dir():
+        return None
+    found = [
+        (int(m[1]), folder / m[0])
+        for p in folder.iterdir()
+        if (m := re.fullmatch(r"rl_model_(\d+)_steps\.zip", p.name))
+    ]
     return max(found)[1] if found else None
 
 
