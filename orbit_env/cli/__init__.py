@@ -75,9 +75,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         cache.disable()
         os.environ[cache.ENV_VAR] = "off"  # and in the worker processes a batch starts
     # SIGTERM (a session's end, ``kill``) stops a command as Ctrl-C does: workers stopped, parts and a
-    # training's checkpoint kept (only in the main thread, where signal handlers live; restored after).
-    main_thread = threading.current_thread() is threading.main_thread()
-    before = signal.signal(signal.SIGTERM, _interrupt) if main_thread else None
+    # training's checkpoint kept. Only in the main thread, where signal handlers live, and not over a handler
+    # set outside Python (which could not be put back); restored after.
+    ours = threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGTERM) is not None
+    before = signal.signal(signal.SIGTERM, _interrupt) if ours else None
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
@@ -89,5 +90,5 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
     finally:
-        if main_thread:
+        if ours:
             signal.signal(signal.SIGTERM, before)
