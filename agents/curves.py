@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from orbit_env.agents.sweep import bootstrap_interval, capture_of, iqm, score_model, train_trial
+from orbit_env.analysis.catalogue_io import atomic_text
 from orbit_env.workers import spawned_pool
 
 #: The algorithms of the curves: SB3's PPO with its defaults, and the project's recipe.
@@ -93,9 +94,8 @@ def run_curve(
     run = {"algo": algo, "seed": seed, "points": points, "wall_s": time.perf_counter() - start}
     path = out / "curves" / f"{algo}_seed{seed}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    part = path.with_suffix(".part")
-    part.write_text(json.dumps(run) + "\n")
-    part.replace(path)  # whole or not at all: a cut run is run again
+    with atomic_text(path) as handle:  # whole or not at all: a cut run is run again
+        handle.write(json.dumps(run) + "\n")
     return run
 
 

@@ -30,6 +30,7 @@ except ImportError as error:  # pragma: no cover - depends on the installation
 
 from orbit_env.agents import VALIDATION_SEED  # the evaluation callback's (training uses the config's seed)
 from orbit_env.agents.shaping import SHAPINGS
+from orbit_env.analysis.catalogue_io import atomic_text
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
@@ -368,9 +369,8 @@ class BestModelCallback(BaseCallback):
             _save_whole(self.model, self.best_model_path)
         self.logger.record("eval/best_mean_reward", self.best_mean)
         self.evaluations.append({"timesteps": int(self.model.num_timesteps), "mean_return": mean})
-        written = self.save_dir / "evaluations.json.partial"
-        written.write_text(json.dumps(self.evaluations, indent=1) + "\n")
-        written.replace(self.save_dir / "evaluations.json")  # whole or not at all
+        with atomic_text(self.save_dir / "evaluations.json") as handle:
+            handle.write(json.dumps(self.evaluations, indent=1) + "\n")
         return mean
 
 
@@ -448,12 +448,21 @@ class TrainingInterrupted(KeyboardInterrupt):
         return TrainingInterrupted, (self.checkpoint, self.timesteps)
 
 
-def _save_whole(model: Any, path: Path) -> None:
-    """``model.save(path)``, written aside and moved in (a rename: the file is whole or absent)."""
+def _written_whole(path: Path, write: Callable[[Path], object]) -> None:
+    """``write(file)`` into ``.partial/`` beside ``path``, then the file moved to ``path`` (a rename: whole or absent).
+
+    For the files a library writes by its name (SB3's zip, VecNormalize's pickle); text goes through
+    `orbit_env.analysis.catalogue_io.atomic_text`.
+    """
     partial = path.parent / ".partial"
     partial.mkdir(parents=True, exist_ok=True)
-    model.save(partial / path.name, exclude=["env", "tensorboard_log"])
+    write(partial / path.name)
     (partial / path.name).replace(path)
+
+
+def _save_whole(model: Any, path: Path) -> None:
+    """``model.save(path)`` without the env, written whole (`_written_whole`)."""
+    _written_whole(path, lambda file: model.save(file, exclude=["env", "tensorboard_log"]))
 
 
 def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
@@ -463,13 +472,10 @@ def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
     statistics first, so that a checkpoint that exists has them (a run killed while SB3's own callback
     wrote had left a 0-byte or truncated zip, or a zip without its statistics, which resumed with fresh ones).
     """
-    partial = folder / ".partial"
-    partial.mkdir(parents=True, exist_ok=True)
     path = folder / f"rl_model_{timesteps}_steps.zip"
     normalize = model.get_vec_normalize_env()
     if normalize is not None:
-        normalize.save(str(partial / _vecnormalize_path(path).name))
-        (partial / _vecnormalize_path(path).name).replace(_vecnormalize_path(path))
+        _written_whole(_vecnormalize_path(path), lambda file: normalize.save(str(file)))
     _save_whole(model, path)
     return path
 
@@ -607,8 +613,8 @@ def train(
         for old in [*Path(out, "checkpoints").glob("rl_model_*"), *(out / name for name in _RUN_FILES)]:
             old.unlink(missing_ok=True)
     out.mkdir(parents=True, exist_ok=True)
-    # The run's settings, so that a resume continues the same run.
-    (out / "config.json").write_text(json.dumps(config, indent=1, sort_keys=True) + "\n")
+    with atomic_text(out / "config.json") as handle:  # the run's settings, so that a resume continues the same run
+        handle.write(json.dumps(config, indent=1, sort_keys=True) + "\n")
     torch.set_num_threads(1)  # small networks: threads cost more than they give on 2 cores
     seed = int(config["seed"])
     venv: Any = training_env(config)
