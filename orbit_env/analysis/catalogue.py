@@ -199,7 +199,10 @@ def _stepped_spread(
 
 
 def _counting(bar: Any, size: int) -> Callable[[float], None]:
-    """A `propagate` progress callback: ``bar`` (tqdm) moves by the share of ``size`` satellites re-entered."""
+    """``size`` satellites' share of ``bar`` (tqdm), from where it stands: called with the share done (1.0: all).
+
+    A `propagate` progress callback (the share re-entered), or called once with 1.0 when they are done.
+    """
     start = bar.n
 
     def reentering(fraction: float) -> None:
@@ -291,9 +294,9 @@ def batch_lifetimes(
         if one_family:
             members = np.flatnonzero(ok)
             if scenario.time_varying:
-                start = bar.n
+                counted = _counting(bar, members.size)
                 families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs, bar))
-                bar.update(start + members.size - bar.n)
+                counted(1.0)
             elif rule_years is None:
                 families.add(_spread_batch(scenario, members, group_of, inputs, days, reentered, bar))
             else:  # the rule's search for the lowered perigee on the same family
@@ -309,9 +312,9 @@ def batch_lifetimes(
             inclination = float(group) if depends_on_inclination else float(inclination_deg[members[0]])
             blocks = [members] if scenario.time_varying else np.array_split(members, max(1, members.size // BLOCK))
             for block in blocks:
-                start = bar.n
+                counted = _counting(bar, block.size)
                 if rule_years is None:
-                    moving = _counting(bar, block.size) if scenario.time_varying else None
+                    moving = counted if scenario.time_varying else None
                     d, r = scenario.lifetime_days(
                         perigee_m[block], apogee_m[block], drag_parameter_m2_kg[block], inclination, progress=moving
                     )
@@ -325,7 +328,7 @@ def batch_lifetimes(
                     _store_check(
                         outputs, block, check_disposal_rule(perigee_m[block], apogee_m[block], rule_years, lifetimes)
                     )
-                bar.update(start + block.size - bar.n)
+                counted(1.0)
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:
             status[i] = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"
@@ -395,7 +398,7 @@ def _from_own_epochs(
         # Rows with no lifetime to compute go with the first date: their records say why.
         for k, date in enumerate(dates if dates.size else [np.nan]):
             members = np.flatnonzero((valid & (epoch_days == date)) | (~valid & (k == 0)))
-            start = bar.n
+            counted = _counting(bar, int(valid[members].sum()))
             part, summary = batch_lifetimes(
                 [rows[i] for i in members],
                 *(x[members] for x in inputs),
@@ -411,5 +414,5 @@ def _from_own_epochs(
                 record_date["reentry_date"] = iso_datetime(float(epoch_days[i]) + float(days)) if days else ""
                 status[i] = record.pop("status")
                 records[i] = {**record, **record_date, "status": status[i]}
-            bar.update(start + int(valid[members].sum()) - bar.n)
+            counted(1.0)
     return records, BatchSummary(rows=len(rows), ok=sum(s == "ok" for s in status), groups=groups)
