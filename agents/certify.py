@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, predicted_actions, task_of
+from orbit_env.agents.evaluate import policy_name as evaluated_name  # the Certificate's policy_name is its text
 from orbit_env.envs import SOLAR_ENV_IDS, SOLAR_EVAL_SPLIT
 
 FloatArray = NDArray[np.float64]
@@ -430,7 +431,7 @@ def certify(
         plans_scored=plans.scored,
         replay_max_error=replay_error,
         start_dates=optimum.start_dates,
-        policy_name="DP policy" if policy is None else f"policy {type(policy).__name__}",
+        policy_name="DP policy" if policy is None else f"policy {evaluated_name(policy)}",
     )
 
 

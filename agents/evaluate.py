@@ -92,8 +92,8 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
     (2.7 was the 30 m/s burn, -1 the largest).
     """
     rows = len(observations)
+    name = policy_name(policy)
     if not hasattr(policy, "predict") and callable(policy):  # a plain function: observations -> actions
-        name = getattr(policy, "__name__", type(policy).__name__)
         returned = (policy(observations), None)
         if isinstance(returned[0], tuple):
             raise ValueError(
@@ -101,7 +101,6 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
                 "predict, pass the policy, not its predict)"
             )
     else:
-        name = type(policy).__name__
         _check_predict(policy, name, observations)
         returned = policy.predict(observations, deterministic=True)
         if not (isinstance(returned, tuple) and len(returned) == 2):
@@ -145,6 +144,13 @@ def predicted_actions(policy: Any, observations: Any, space: Any) -> NDArray[Any
         if beyond.any():
             raise ValueError(f"{name}.predict returned action {actions[beyond][0]:g}, beyond {space.dtype}")
     return actions.astype(space.dtype)
+
+
+def policy_name(policy: Any) -> str:
+    """How messages name a policy: a plain function by its name, an object with ``predict`` by its class."""
+    if not hasattr(policy, "predict") and callable(policy):
+        return getattr(policy, "__name__", type(policy).__name__)
+    return type(policy).__name__
 
 
 def _check_predict(policy: Any, name: str, observations: Any) -> None:
@@ -198,10 +204,9 @@ def run_episodes(
             if first:  # the same observations asked again: a policy that answers otherwise is not reproducible
                 first = False
                 if not np.array_equal(predicted_actions(policy, obs[rows], env.single_action_space), actions[rows]):
-                    name = getattr(policy, "__name__", type(policy).__name__)
                     warnings.warn(
-                        f"{name} acts otherwise on the same observations (deterministic=True asked): its scores "
-                        "change from run to run, and a paired difference against it is not reproducible",
+                        f"{policy_name(policy)} acts otherwise on the same observations (deterministic=True asked): "
+                        "its scores change from run to run, and a paired difference against it is not reproducible",
                         UserWarning,
                         stacklevel=2,
                     )

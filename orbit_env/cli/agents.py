@@ -74,9 +74,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     if args.returns and not args.certify:
         check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
-        flags = (("--model", args.model), ("--plot", args.plot), ("--no-dp", args.no_dp), ("--returns", args.returns))
-        flags += (("--name", args.name),)
-        given = [flag for flag, value in flags if value]
+        flags = {
+            "--model": args.model,
+            "--plot": args.plot,
+            "--no-dp": args.no_dp,
+            "--returns": args.returns,
+            "--name": args.name,
+        }
+        given = [flag for flag, value in flags.items() if value]
         if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
         return _certify(args, say)
