@@ -46,6 +46,7 @@ from numpy.typing import NDArray
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents.evaluate import EVAL_SEED, Predictor, check_env_id, dp_policy, predicted_actions, task_of
 from orbit_env.agents.evaluate import policy_name as evaluated_name  # the Certificate's policy_name is its text
+from orbit_env.checks import check_int
 from orbit_env.envs import SOLAR_ENV_IDS, SOLAR_EVAL_SPLIT
 
 FloatArray = NDArray[np.float64]
@@ -363,10 +364,11 @@ def certify(
 
     Raises:
         ValueError: an unknown env, one whose density is not known (its optimum is the
-            oracle's), or counts below 1.
+            oracle's), counts below 1, or a negative seed.
     """
     if episodes < 1 or rounds < 0 or perturbations < 1:
         raise ValueError("episodes and perturbations must be >= 1, rounds >= 0")
+    check_int(seed, "seed", low=0)
     if env_id in SOLAR_ENV_IDS and policy is not None:
         raise ValueError(
             f"{env_id}: the certificate searches plans against each mission's DP policy only; score your policy "

@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 import orbit_env  # noqa: F401  (registers the environments)
 from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 from orbit_env.agents.policies import HAND_CODED
+from orbit_env.checks import check_int
 from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS
 
 FloatArray = NDArray[np.float64]
@@ -176,12 +177,13 @@ def run_episodes(
 ) -> Episodes:
     """Play one episode per sub-environment of a seeded vector env with ``policy``.
 
-    ``env_kwargs``: the environment's keywords (``horizon_steps=...``, see
-    `orbit_env.envs.OrbitRaisingEnv`).
+    ``seed``: an integer >= 0, as Gymnasium seeds. ``env_kwargs``: the environment's keywords
+    (``horizon_steps=...``, see `orbit_env.envs.OrbitRaisingEnv`).
     """
     check_env_id(env_id)
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
+    check_int(seed, "seed", low=0)
     env = gymnasium.make_vec(env_id, num_envs=episodes, **dict(env_kwargs or {}))
     obs, _ = env.reset(seed=seed)
     cost = env.unwrapped.config.propellant_cost_per_m_s

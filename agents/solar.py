@@ -457,6 +457,7 @@ def evaluate_solar(
     its Box, the DP on a finer grid of burns (`orbit_env.agents.solar_dp.dp_task`); the rules are the same.
     """
     check_int(episodes, "episodes", low=1)
+    check_int(seed, "seed", low=0)
     mission = SolarMission(solar_split=solar_split, disposal_years=disposal_years)
     task = SolarTask(mission=mission, continuous=continuous)
     names = {rule.name for rule in registered_rules()} | {"dp"}

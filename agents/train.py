@@ -31,6 +31,7 @@ except ImportError as error:  # pragma: no cover - depends on the installation
 from orbit_env.agents import VALIDATION_SEED  # the evaluation callback's (training uses the config's seed)
 from orbit_env.agents.shaping import SHAPINGS
 from orbit_env.analysis.catalogue_io import atomic_text
+from orbit_env.checks import check_int
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
@@ -187,15 +188,34 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     return config
 
 
-def _check_values(config: dict[str, Any], source: str) -> None:
-    """The values' ranges and the combinations that cannot work (ValueError naming the key)."""
+def check_trainable(env_id: str, given: str) -> None:
+    """ValueError unless ``env_id`` is an environment of this package; ``given`` says where it came from.
+
+    ``given`` begins the message: ``ppo.toml: env_id = 'Nope-v0'``, ``env_id='Nope-v0'``, ``--env Nope-v0``.
+    """
     from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS
 
     allowed = (*ENV_IDS, *SOLAR_ENV_IDS)
-    if config["env_id"] not in allowed:
-        raise ValueError(
-            f"{source}: env_id = {config['env_id']!r} is not an orbit_env environment; allowed: {', '.join(allowed)}"
-        )
+    if env_id not in allowed:
+        raise ValueError(f"{given} is not an orbit_env environment; allowed: {', '.join(allowed)}")
+
+
+def _check_overrides(overrides: dict[str, Any]) -> None:
+    """The arguments of `train` that override the config, named as the caller gave them (not as the file's keys)."""
+    for key in ("num_envs", "total_timesteps"):
+        if overrides[key] is not None:
+            check_int(overrides[key], key, low=1)
+    if overrides["seed"] is not None:
+        check_int(overrides["seed"], "seed", low=0)
+    if overrides["env_id"] is not None:
+        check_trainable(overrides["env_id"], f"env_id={overrides['env_id']!r}")
+
+
+def _check_values(config: dict[str, Any], source: str) -> None:
+    """The values' ranges and the combinations that cannot work (ValueError naming the key)."""
+    from orbit_env.envs import SOLAR_ENV_IDS
+
+    check_trainable(config["env_id"], f"{source}: env_id = {config['env_id']!r}")
     for key in ("seed", "checkpoint_every", "eval_every"):
         if config[key] < 0:
             raise ValueError(f"{source}: {key} = {config[key]} is invalid; allowed: an integer >= 0")
@@ -569,6 +589,7 @@ def train(
     config = load_config(config_path)
     source = DEFAULT_CONFIG if config_path is None else str(config_path)
     overrides = {"total_timesteps": total_timesteps, "seed": seed, "num_envs": num_envs, "env_id": env_id}
+    _check_overrides(overrides)  # a bad argument is the argument's, not the file's
     for key, value in overrides.items():
         if value is not None:
             config[key] = value

@@ -9,13 +9,16 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from orbit_env.checks import check_int
 from orbit_env.cli.common import PROG, check_figure, check_output, positive_int
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
 def _cmd_train(args: argparse.Namespace) -> int:
-    from orbit_env.agents.train import TrainingInterrupted, train
+    from orbit_env.agents.train import TrainingInterrupted, check_trainable, train
 
+    if args.env is not None:  # the flag's value, named by the flag (train itself names the config file's key)
+        check_trainable(args.env, f"--env {args.env}")
     try:
         result = train(
             args.config,
@@ -68,6 +71,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     from orbit_env.envs import SOLAR_ENV_IDS
 
+    check_int(args.seed, "seed", low=0)  # before the model's load and the DP's solve
     _solar_options(args, args.env in SOLAR_ENV_IDS)
     if args.plot and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
