@@ -124,6 +124,7 @@ class InputError(ValueError):
         unit: str | None = None,
         rename: Callable[[str], str] | None = None,
         show_index: bool = True,
+        shift: float = 0.0,
     ) -> str:
         """The message, optionally in a front end's words.
 
@@ -137,6 +138,8 @@ class InputError(ValueError):
             rename: Maps the names of bounds taken from other parameters.
             show_index: Append the bad element's index to the label (a front end
                 that names the element its own way, say by a date, turns it off).
+            shift: Added to the bounds after ``scale`` (and to the value if ``value_text`` is not
+                given): a height checked above one surface, shown above the user's.
         """
         rename = rename or (lambda name: name)
         unit = self.unit if unit is None else unit
@@ -145,8 +148,8 @@ class InputError(ValueError):
             label += "[" + ", ".join(str(i) for i in self.index) + "]"
         if value_text is None:
             shown = self.value
-            if scale != 1.0 and self.problem in ("finite", "range", "integer"):
-                shown = float(self.value) * scale
+            if (scale != 1.0 or shift != 0.0) and self.problem in ("finite", "range", "integer"):
+                shown = float(self.value) * scale + shift
             value_text = format_number(shown)
         head = f"{label} {value_text}" if label.startswith("-") else f"{label}={value_text}"
         if self.problem == "number" and isinstance(self.value, (str, np.str_)):
@@ -163,17 +166,17 @@ class InputError(ValueError):
             text = f"{head} is not a finite number"
         else:
             text = f"{head} is out of range"
-        allowed = self._allowed(scale, unit, rename, show_index)
+        allowed = self._allowed(scale, unit, rename, show_index, shift)
         if allowed:
             text += f"; allowed: {allowed}"
         if self.why:
             text += f" ({self.why})"
         return text
 
-    def _allowed(self, scale: float, unit: str, rename: Callable[[str], str], show_index: bool) -> str:
+    def _allowed(self, scale: float, unit: str, rename: Callable[[str], str], show_index: bool, shift: float) -> str:
         def bound(value: float | None, name: str | None) -> str:
             assert value is not None
-            number = format_number(float(value) * scale)
+            number = format_number(float(value) * scale + shift)
             if name is None:
                 return number
             index = "" if self.index is None or not show_index else "[" + ", ".join(str(i) for i in self.index) + "]"

@@ -46,7 +46,7 @@ from orbit_env.checks import InputError, check_date, check_number
 from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, SECONDS_PER_DAY
 from orbit_env.csvfile import cell_value, read_csv
 from orbit_env.decay.curves import NU_REF, UniversalCurves
-from orbit_env.decay.solar import unix_days
+from orbit_env.decay.solar import iso_date, unix_days
 from orbit_env.physics.orbit import elements_from_heights, period_s
 
 FloatArray = NDArray[np.float64]
@@ -261,8 +261,9 @@ def fit_density_scale(
         height_sigma_km: Uncertainty of the first orbit's heights (reentry fits).
 
     Raises:
-        ValueError: too few observations, a re-entry before the first orbit, heights
-            outside the curves, or an orbit that does not come down from the first observation to the last.
+        ValueError: too few observations, a re-entry before the last orbit observed, heights
+            outside the curves, an orbit that does not come down from the first observation to the last,
+            or data that leave the scale undetermined (its 68% interval beyond `DENSITY_SCALE_RANGE`).
     """
     c = satellite.drag_parameter_m2_kg
     try:
@@ -272,8 +273,16 @@ def fit_density_scale(
         raise ValueError(f"{observations.where(row)}: {error.message(show_index=False)}") from None
     if reentry is not None:
         dt_days = reentry_days(reentry, observations) - float(observations.days[0])
+        if not isinstance(reentry, str):  # as the observations give times: a date or a number of days
+            reentry = iso_date(float(reentry)) if observations.axis == "date" else f"{float(reentry):g}"
         if not dt_days > 0:
             raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
+        last = float(observations.days[-1] - observations.days[0])
+        if not dt_days > last:
+            raise ValueError(
+                f"the re-entry ({reentry}) comes {last - dt_days:.4g} days before the last observation "
+                f"({observations.where(observations.days.size - 1)}): an orbit cannot be observed after it re-entered"
+            )
         check_number(reentry_sigma_days, "reentry_sigma_days", unit="days", low=0.0)
         check_number(height_sigma_km, "height_sigma_km", unit="km", low=0.0)
         return _plausible(
@@ -409,7 +418,7 @@ def _fit_orbits_time_varying(
         scale=math.exp(log_s),
         sigma_log=sigma_log,
         dof=dof,
-        description=f"{hp.size} orbits over {t[-1]:.4g} days under the record's Sun ({observations.source})",
+        description=f"{hp.size} orbits over {t[-1]:.4g} days, in the air of their days ({observations.source})",
         residual_rms_km=math.sqrt(max(rss_min, 0.0) / (2 * hp.size)) / 1e3,
     )
 
@@ -426,6 +435,13 @@ def _plausible(fit: DensityFit) -> DensityFit:
         raise ValueError(
             f"the fitted density scale, {fit.scale:.3g}, is outside {low:g} to {high:g}: the data do not fit "
             "this satellite in this atmosphere (check its mass and area, the heights and the times)"
+        )
+    low68, high68 = fit.interval(0.68)
+    if not low <= low68 <= high68 <= high:
+        raise ValueError(
+            f"the data do not determine the density scale: {fit.scale:.3g}, but anything from {low68:.3g} to "
+            f"{high68:.3g} (68%) fits them, beyond {low:g} to {high:g}; the orbits do not follow one decay (a "
+            "manoeuvre between two observations, or observations of more than one object) or hardly decay over the span"
         )
     return fit
 

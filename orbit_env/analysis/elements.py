@@ -23,13 +23,14 @@ in which case no drag parameter follows from it (give the satellite instead).
 from __future__ import annotations
 
 import math
+import re
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
-from orbit_env.checks import check_number
+from orbit_env.checks import DATE_RANGE, check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M
 
 #: SGP4's reference density of B* [kg/(m^2 ER)]: C_D A / m = 2 B* / rho0.
@@ -38,6 +39,13 @@ BSTAR_REFERENCE_DENSITY = 0.15696615
 EQUATORIAL_RADIUS_KM = EARTH_EQUATORIAL_RADIUS_M / 1e3
 #: Length of a TLE line (69 columns, the last one the checksum).
 TLE_LINE_LENGTH = 69
+
+
+def _iso(epoch_days: float) -> str:
+    """Unix days as ISO 8601 UTC to the second."""
+    import numpy as np
+
+    return str(np.datetime64(round(epoch_days * 86400.0), "s")) + "Z"
 
 
 def tle_checksum(line: str) -> int:
@@ -112,11 +120,7 @@ class ElementSet:
     @property
     def epoch_iso(self) -> str | None:
         """The epoch as ISO 8601 UTC to the second (None without an epoch)."""
-        if self.epoch_days is None:
-            return None
-        import numpy as np
-
-        return str(np.datetime64(round(self.epoch_days * 86400.0), "s")) + "Z"
+        return None if self.epoch_days is None else _iso(self.epoch_days)
 
     def measured_at(self, days: float) -> bool:
         """Whether ``days`` [unix days] is the set's epoch (the same second, any form): where a decay of it starts."""
@@ -155,6 +159,43 @@ def _check_line(text: str, number: str, where: str) -> None:
         raise ValueError(f"{where}: bad checksum {text[68]} (the line sums to {expected})")
 
 
+#: A number of the fields the layout gives (columns of Spacetrack Report #3; CelesTrak's "NORAD Two-Line
+#: Element Set Format"), as a regular expression on the field's text.
+_DECIMAL = re.compile(r"^ *[+-]?\d*\.\d+$|^ *[+-]?\d+\.?\d*$")
+#: Line 1's "assumed decimal point" fields (B*, the second derivative): a sign, five digits, an exponent.
+_ASSUMED_DECIMAL = re.compile(r"^[ +-]\d{5}[ +-]\d$")
+#: (line, first column, last column (1-based, inclusive), field, pattern, lowest, highest): what each field may hold.
+_FIELDS = (
+    (1, 19, 20, "epoch year", re.compile(r"^\d\d$"), -math.inf, math.inf),
+    (1, 21, 32, "epoch day of the year", re.compile(r"^ *\d{1,3}\.\d+$"), 1.0, 366.99999999),
+    (1, 34, 43, "first derivative of the mean motion", _DECIMAL, -math.inf, math.inf),
+    (1, 45, 52, "second derivative of the mean motion", _ASSUMED_DECIMAL, -math.inf, math.inf),
+    (1, 54, 61, "B*", _ASSUMED_DECIMAL, -math.inf, math.inf),
+    (2, 9, 16, "inclination [deg]", _DECIMAL, 0.0, 180.0),
+    (2, 18, 25, "right ascension of the ascending node [deg]", _DECIMAL, 0.0, 360.0),
+    (2, 27, 33, "eccentricity (seven digits, decimal point assumed)", re.compile(r"^\d{7}$"), -math.inf, math.inf),
+    (2, 35, 42, "argument of perigee [deg]", _DECIMAL, 0.0, 360.0),
+    (2, 44, 51, "mean anomaly [deg]", _DECIMAL, 0.0, 360.0),
+    (2, 53, 63, "mean motion [rev/day]", _DECIMAL, 0.0, 20.0),
+)
+
+
+def _check_fields(line1: str, line2: str, where1: str, where2: str) -> None:
+    """Raise ValueError naming the line, the columns and the field if a number of the set is not one it may hold.
+
+    SGP4's reader takes what it can from a damaged field (a blank epoch year, letters in B*, day 400 of a
+    year), which would fly a wrong orbit or date with no word; its own errors name no field.
+    """
+    for line_number, first, last, field, pattern, lowest, highest in _FIELDS:
+        line, where = (line1, where1) if line_number == 1 else (line2, where2)
+        text = line[first - 1 : last]
+        if not pattern.match(text):
+            raise ValueError(f"{where}, columns {first}-{last}: the {field} reads {text!r}, not a number of its form")
+        if (math.isfinite(lowest) or math.isfinite(highest)) and not lowest <= float(text) <= highest:
+            allowed = f"{lowest:.12g} to {highest:.12g}"
+            raise ValueError(f"{where}, columns {first}-{last}: the {field} is {text.strip()}; allowed: {allowed}")
+
+
 def parse_tle(
     line1: str, line2: str, name: str | None = None, *, source: str = "TLE", first_line: int = 1
 ) -> ElementSet:
@@ -177,6 +218,7 @@ def parse_tle(
     where1, where2 = f"{source}, line {first_line}", f"{source}, line {first_line + 1}"
     _check_line(line1, "1", where1)
     _check_line(line2, "2", where2)
+    _check_fields(line1, line2, where1, where2)
     if line1[2:7] != line2[2:7]:
         raise ValueError(f"{where2}: catalogue number {line2[2:7].strip()} differs from line 1's {line1[2:7].strip()}")
     try:
@@ -188,6 +230,12 @@ def parse_tle(
             f"{where1}: SGP4 refuses the elements (error {satrec.error}: {_SGP4_ERRORS.get(satrec.error)})"
         )
     epoch_days = (satrec.jdsatepoch - 2440587.5) + satrec.jdsatepochF
+    (first_day, first_date), _ = DATE_RANGE  # two-digit years reach 2056 at most
+    if epoch_days < first_day:
+        raise ValueError(
+            f"{where1}, columns 19-32: the epoch is {_iso(epoch_days)} (a two-digit year 57-99 is 1957-1999); "
+            f"allowed: from {first_date} (no satellite flew before Sputnik 1)"
+        )
     # satrec.a is the Brouwer mean semi-major axis in Earth radii (of the WGS72 constants SGP4 uses).
     a_km = satrec.a * satrec.radiusearthkm
     return ElementSet(
@@ -277,9 +325,22 @@ def read_tle(path: str | Path, bad: list[BadSet] | None = None) -> list[ElementS
         OSError: the file cannot be read.
     """
     if str(path) == "-":
-        return parse_tle_text(sys.stdin.read().removeprefix("\ufeff").splitlines(), "<stdin>", bad)
-    with open(path, encoding="utf-8-sig") as handle:  # a byte-order mark (Windows' editors) is no part of a name
-        return parse_tle_text(handle.read().splitlines(), str(path), bad)
+        data = sys.stdin.buffer.read() if hasattr(sys.stdin, "buffer") else sys.stdin.read().encode()
+        return parse_tle_text(_text(data).splitlines(), "<stdin>", bad)
+    with open(path, "rb") as handle:
+        return parse_tle_text(_text(handle.read()).splitlines(), str(path), bad)
+
+
+def _text(data: bytes) -> str:
+    """A file's text: UTF-8 (a byte-order mark, from Windows' editors, is no part of a name), else Latin-1.
+
+    The sets' lines are ASCII; a name line in another encoding is read as Latin-1 (every byte is a
+    character), so bytes that are no text give a message naming a line, not a decoding error naming none.
+    """
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
 
 
 def looks_like_tle(path: str | Path) -> bool:

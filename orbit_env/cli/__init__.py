@@ -41,12 +41,16 @@ def build_parser() -> Parser:
     return parser
 
 
+#: The commands' positional arguments that name files (fit-density's OBS_CSV, solar update's FILE).
+POSITIONALS = ("observations", "file")
+
+
 def _in_files(error: Exception, args: object) -> str:
     """An error's text; a file that cannot be read named with the flag it came from (``--tle x.tle: ...``)."""
     if not (isinstance(error, OSError) and error.filename and error.strerror):
         return str(error)
     name = next((key for key, value in vars(args).items() if isinstance(value, str) and value == error.filename), None)
-    where = f"{flag(name)} " if name and name != "observations" else ""  # the positional OBS_CSV has no flag
+    where = f"{flag(name)} " if name and name not in POSITIONALS else ""  # a positional argument has no flag
     return f"{where}{error.filename}: {error.strerror.lower()}"
 
 

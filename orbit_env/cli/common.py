@@ -189,7 +189,28 @@ def in_flags(error: InputError, args: argparse.Namespace) -> str:
         scale=factor,
         unit=unit,
         rename=lambda name: flag(FLAGS[name][0]) if name in FLAGS else name,
+        shift=_height_shift_km(error, args, typed),
     )
+
+
+def _height_shift_km(error: InputError, args: argparse.Namespace, typed: Any) -> float:
+    """What turns a height checked above the 6371 km sphere into the user's --height-reference (0 otherwise).
+
+    The decay checks the sphere's heights; a user who typed heights above the equatorial radius reads
+    the bounds in those (the error's value is then the typed one plus the reference's offset).
+    """
+    from orbit_env.analysis.heights import HEIGHT_REFERENCES, offset_km
+
+    reference = getattr(args, "height_reference", None)
+    if error.name not in ("perigee_km", "apogee_km") or reference not in HEIGHT_REFERENCES:
+        return 0.0
+    offset = offset_km(reference)
+    try:
+        shown = float(error.value) * FLAGS[error.name][1]  # in the flag's unit (km)
+        checked_sphere = math.isclose(shown, float(typed) + offset, rel_tol=0.0, abs_tol=1e-6)
+    except (TypeError, ValueError):
+        return 0.0
+    return -offset if offset and checked_sphere else 0.0
 
 
 def positive_int(text: str) -> int:

@@ -69,6 +69,13 @@ def _scenario(args: argparse.Namespace) -> Scenario:
     scenario = Scenario(air, args.density_scale, rotating, chunk_days)
     if args.chunk_days is not None and scenario.epoch_days is None:
         raise ValueError("--chunk-days is the time step of a dated decay: it goes with --epoch (or an element set's)")
+    table, epoch = scenario.activity, scenario.epoch_days
+    if isinstance(table, TableActivity) and epoch is not None and epoch > table.end_days + 1.0:
+        raise ValueError(
+            f"the solar table {table.source} ends on {iso_date(table.end_days)}, before the decay starts on "
+            f"{iso_date(epoch)}: none of its days is one of the decay's; give a table that covers them, or no "
+            "--solar-csv (the shipped record and its forecast)"
+        )
     return scenario
 
 
@@ -348,7 +355,8 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     if args.inclination is None:
         args.inclination = 0.0
     observations = read_observations(args.observations)
-    solar_given = any(given(args, name) for name in ("f107", "f107a", "ap", "solar_csv", "solar_cycle"))
+    # Activity held constant, or a synthetic cycle, has no dates to start from; a --solar-csv table's days do.
+    solar_given = any(given(args, name) for name in ("f107", "f107a", "ap", "solar_cycle"))
     if observations.axis == "date" and args.epoch is not None and not solar_given:
         # The first observation's date, as typed (a day, no time): the air from that observation's moment.
         if math.floor(unix_days(args.epoch)) == math.floor(float(observations.days[0])):
@@ -373,8 +381,9 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
         reentry_sigma_days=args.reentry_sigma_days,
         height_sigma_km=args.height_sigma_km,
     )
-    if reentry is not None and scenario.epoch_days is not None:
-        _warn_solar_table(scenario, scenario.epoch_days + reentry - float(observations.days[0]))
+    if scenario.epoch_days is not None:  # the decay runs to the re-entry, or to the last observation
+        last = float(observations.days[-1]) if reentry is None else reentry
+        _warn_solar_table(scenario, scenario.epoch_days + last - float(observations.days[0]))
     # The scale belongs to the drag parameter it was fitted with: both are said.
     drag = DragSource(satellite, SOURCE_SATELLITE if orbit_inputs.satellite_inputs(args).given else SOURCE_DEFAULT)
     if args.json:

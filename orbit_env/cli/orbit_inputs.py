@@ -140,8 +140,12 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         elements = sets[-1]
         if args.epoch is None and "epoch" in air_model(args.atmosphere or DATED_AIR).options:
             args.epoch = elements.epoch_iso.rstrip("Z")
-        if args.inclination is None:
-            args.inclination = elements.inclination_deg
+        if args.inclination is not None:
+            raise ValueError(
+                f"--inclination: the element set gives the inclination ({elements.inclination_deg:g} deg); "
+                "drop --inclination (to fly that orbit at another, give its heights with --perigee/--apogee)"
+            )
+        args.inclination = elements.inclination_deg
     elif mean_a is not None or ecc is not None:
         from orbit_env.analysis.elements import mean_elements
 
@@ -157,6 +161,8 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
         # Read once (`read_orbits`); a set that does not read is its object's row's status, not the batch's end.
         args.batch_bad_sets = []
         args.batch_sets = read_tle(args.batch, bad=args.batch_bad_sets) if args.batch_element_sets else None
+        if args.batch_element_sets and args.inclination is not None:
+            raise ValueError("--inclination: each object's element set gives its inclination; drop --inclination")
         dated = "epoch" in air_model(args.atmosphere or DATED_AIR).options
         # A batch of element sets: each object from its own latest set's epoch, as --tle starts from its set's.
         if args.batch_sets and args.epoch is None and dated:

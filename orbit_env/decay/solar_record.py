@@ -40,6 +40,7 @@ from __future__ import annotations
 import gzip
 import math
 import os
+import time
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -48,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from orbit_env import cache
+from orbit_env.constants import SECONDS_PER_DAY
 from orbit_env.decay.solar import TableActivity, iso_date, unix_days
 
 FloatArray = NDArray[np.float64]
@@ -161,7 +163,7 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
     sections: dict[str, list[tuple[int, str]]] = {}
     updated = ""
     current = None
-    with open(path) as handle:
+    with open(path, encoding="ascii", errors="replace") as handle:  # CelesTrak's files are ASCII
         for number, raw in enumerate(handle, start=1):
             line = raw.rstrip("\n")
             if line.startswith("UPDATED"):
@@ -354,6 +356,13 @@ def update(path: str | Path) -> tuple[RecordActivity, Path]:
     """
     shipped = _load(str(SHIPPED_RECORD))
     record = parse_celestrak(path, base=load_record())
+    today = time.time() / SECONDS_PER_DAY
+    if record.observed_end_days > today + 1.0:
+        raise ValueError(
+            f"{path}: its observations end on {iso_date(record.observed_end_days)}, after today "
+            f"({iso_date(math.floor(today))}): an observed day cannot lie ahead (check the file's dates, and this "
+            "machine's clock); nothing imported"
+        )
     if record.observed_end_days < shipped.observed_end_days:
         raise ValueError(
             f"{path}: its observations end on {iso_date(record.observed_end_days)}, before the shipped record's "

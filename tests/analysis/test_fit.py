@@ -133,7 +133,7 @@ def test_dated_orbits_are_fitted_under_the_records_sun(dated_truth, tmp_path, ca
     # interpolated by a parabola: within 2% of 0.6. (The same orbits fitted at a constant F10.7 150, as
     # fit-density did for a dated file, give 0.42: measured, 30% off.)
     assert fit.scale == pytest.approx(0.6, rel=0.02)
-    assert "record's Sun" in fit.description
+    assert "in the air of their days" in fit.description
     # The command line: a file of dates makes the air NRLMSIS under the record from the first date.
     path = tmp_path / "dated.csv"
     rows = [f"{np.datetime64(round(d * 86400), 's')},{p},{a}" for d, p, a in zip(days, hp, ha, strict=True)]

@@ -213,3 +213,24 @@ def test_an_old_record_without_the_3_hourly_ap_still_loads(tmp_path, monkeypatch
     # An update on top of it keeps the old days without, and takes the new file's.
     newer = parse_celestrak(sw_file(tmp_path, [("2099-01-01", 150.0, 140.0, 20)], name="SW-Last5Years.txt"), record)
     assert np.isnan(newer.ap3[:-1]).all() and list(newer.ap3[-1]) == [20.0] * 8
+
+
+def test_solar_update_refuses_observations_dated_ahead_of_today(tmp_path, monkeypatch, capsys):
+    # A file whose last observed row is dated 2300 had been imported: `solar show` then called the days to 2300
+    # observed, and a decay in 2100 ran on them. An observed day cannot lie ahead of the machine's clock.
+    monkeypatch.setenv("ORBIT_ENV_DATA_DIR", str(tmp_path / "data"))
+    end = read_record(SHIPPED_RECORD).observed_end_days
+    rows = [(str(np.datetime64(int(end) + k, "D")), 150.0, 140.0, 20) for k in (0, 1)] + [
+        ("2300-07-03", 150.0, 140.0, 20)
+    ]
+    path = sw_file(tmp_path, rows, name="far.txt")
+    assert main(["solar", "update", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "its observations end on 2300-07-03, after today" in err and "nothing imported" in err
+    assert not (tmp_path / "data").exists() or not any((tmp_path / "data").rglob("*.csv*"))
+
+
+def test_solar_update_names_a_missing_file_without_a_flag_it_has_not(tmp_path, capsys):
+    missing = tmp_path / "SW-All.txt"
+    assert main(["solar", "update", str(missing)]) == 2
+    assert capsys.readouterr().err == f"orbit-env: error: {missing}: no such file or directory\n"  # not "--file ..."
