@@ -55,16 +55,17 @@ def run_curve(
 ) -> dict[str, Any]:
     """Train one run and score it at its points; write and return ``{"algo", "seed", "points", "wall_s"}``.
 
-    ``points``: ``[timesteps, mean return, capture]`` at step 0, every ``every`` steps and at the end.
+    ``points``: ``[timesteps, mean return, capture]`` at step 0, every ``every`` steps and at the end; the
+    capture None (JSON null) where it is undefined (never burning as good as the DP on the episodes).
     """
     from stable_baselines3.common.callbacks import BaseCallback
 
-    points: list[list[float]] = []
+    points: list[list[float | None]] = []
 
     def score(model: Any, steps: int) -> None:
         mean = score_model(env_id, model, episodes, eval_seed)
         capture = capture_of(mean, references)
-        points.append([float(steps), mean, float("nan") if capture is None else capture])
+        points.append([float(steps), mean, capture])
 
     class CaptureCurve(BaseCallback):  # type: ignore[misc]
         """Scores the policy being trained at its points (see `run_curve`).
@@ -103,22 +104,25 @@ def _run_curve(job: tuple[Any, ...]) -> dict[str, Any]:
     return run_curve(*job)
 
 
-def aggregate(runs: Sequence[dict[str, Any]]) -> dict[str, dict[str, list[float]]]:
+def aggregate(runs: Sequence[dict[str, Any]]) -> dict[str, dict[str, list[float | None]]]:
     """Per algorithm, at each point all its runs reached: the IQM of the capture over seeds and its 95% CI.
 
     The runs of an algorithm share their points up to the rollout size (the same
-    ``every`` and hyperparameters); each point's step is the seeds' median.
+    ``every`` and hyperparameters); each point's step is the seeds' median. A point where a
+    run's capture is undefined (None) has none of the three (None, JSON null).
     """
-    curves: dict[str, dict[str, list[float]]] = {}
+    curves: dict[str, dict[str, list[float | None]]] = {}
     for algo in dict.fromkeys(run["algo"] for run in runs):
+        # None (and NaN, in a file written before the captures were null) reads as NaN.
         mine = [np.asarray(run["points"], dtype=np.float64) for run in runs if run["algo"] == algo]
         count = min(len(points) for points in mine)
         steps = np.median([points[:count, 0] for points in mine], axis=0)
         captures = np.array([points[:count, 2] for points in mine])  # (seeds, points)
-        intervals = [bootstrap_interval(captures[:, k]) for k in range(count)]
+        defined = np.isfinite(captures).all(axis=0)
+        intervals = [bootstrap_interval(captures[:, k]) if defined[k] else (None, None) for k in range(count)]
         curves[algo] = {
             "timesteps": steps.tolist(),
-            "iqm_capture": [iqm(captures[:, k]) for k in range(count)],
+            "iqm_capture": [iqm(captures[:, k]) if defined[k] else None for k in range(count)],
             "ci95_low": [low for low, _ in intervals],
             "ci95_high": [high for _, high in intervals],
             "seeds": [float(len(mine))] * count,
@@ -212,8 +216,9 @@ def curves(
 
 def _finished(run: dict[str, Any], count: int, total: int) -> str:
     steps, _, capture = run["points"][-1]
+    score = f"capture {100 * capture:.1f}%" if capture is not None else "no capture (never burning is optimal)"
     return (
-        f"run {count}/{total}: {run['algo']} seed {run['seed']}, capture {100 * capture:.1f}% "
+        f"run {count}/{total}: {run['algo']} seed {run['seed']}, {score} "
         f"after {steps:,.0f} steps, {run['wall_s']:.0f} s"
     )
 
@@ -229,7 +234,10 @@ def format_curves(result: dict[str, Any]) -> str:
         for steps, value, low, high in zip(
             curve["timesteps"], curve["iqm_capture"], curve["ci95_low"], curve["ci95_high"], strict=True
         ):
-            lines.append(f"  {steps:>12,.0f} steps  {100 * value:7.1f}%  [{100 * low:6.1f}%, {100 * high:6.1f}%]")
+            if value is None:
+                lines.append(f"  {steps:>12,.0f} steps  no capture (never burning is optimal on these episodes)")
+            else:
+                lines.append(f"  {steps:>12,.0f} steps  {100 * value:7.1f}%  [{100 * low:6.1f}%, {100 * high:6.1f}%]")
     return "\n".join(lines)
 
 
@@ -245,13 +253,12 @@ def plot_curves(result: dict[str, Any], path: str | Path) -> None:
         color = f"C{k}"
         for run in result["runs"]:
             if run["algo"] == algo:
-                points = np.asarray(run["points"])
+                points = np.asarray(run["points"], dtype=np.float64)  # an undefined capture: a gap
                 ax.plot(points[:, 0], 100 * points[:, 2], color=color, alpha=0.25, linewidth=0.8)
         steps = np.asarray(curve["timesteps"])
-        ax.fill_between(
-            steps, 100 * np.asarray(curve["ci95_low"]), 100 * np.asarray(curve["ci95_high"]), color=color, alpha=0.2
-        )
-        ax.plot(steps, 100 * np.asarray(curve["iqm_capture"]), color=color, linewidth=2, label=f"{algo}: IQM, 95% CI")
+        band = [100 * np.asarray(curve[key], dtype=np.float64) for key in ("ci95_low", "ci95_high", "iqm_capture")]
+        ax.fill_between(steps, band[0], band[1], color=color, alpha=0.2)
+        ax.plot(steps, band[2], color=color, linewidth=2, label=f"{algo}: IQM, 95% CI")
     ax.axhline(100.0, color="black", linewidth=0.8, linestyle=":")
     ax.axhline(0.0, color="grey", linewidth=0.8, linestyle=":")
     ax.set_xlabel("environment steps")

@@ -285,7 +285,7 @@ def paired_difference(
     ``baseline`` None: the best hand-coded policy. Both policies meet the same start
     states, so the per-episode difference has a much smaller spread than either
     return: its mean and standard error say whether a small lead is more than the
-    luck of these episodes.
+    luck of these episodes (``stderr`` None for a single episode, which has none).
     """
     if baseline is None:
         candidates = [b for b in HAND_CODED if b in results]
@@ -293,7 +293,7 @@ def paired_difference(
     if name not in results or baseline not in results:
         return None
     diff = results[name].returns - results[baseline].returns
-    stderr = float(diff.std(ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else float("nan")
+    stderr = float(diff.std(ddof=1) / np.sqrt(diff.size)) if diff.size > 1 else None  # JSON null, never NaN
     return {
         "policy": name,
         "baseline": baseline,
@@ -333,9 +333,13 @@ def format_table(
     if captured:
         lines.append("capture = (R - R_never) / (R_dp - R_never): the share of the optimum's improvement")
     for pair in paired:
+        if pair["stderr"] is None:
+            spread = f"{pair['mean']:+.2f} days (one episode: no standard error)"
+        else:
+            spread = f"{pair['mean']:+.2f} +- {pair['stderr']:.2f} days (mean +- s.e.)"
         lines.append(
-            f"{pair['policy']} - {pair['baseline']}, paired: {pair['mean']:+.2f} +- {pair['stderr']:.2f} days "
-            f"(mean +- s.e.), better on {pair['better']}, worse on {pair['worse']} episodes"
+            f"{pair['policy']} - {pair['baseline']}, paired: {spread}, better on {pair['better']}, "
+            f"worse on {pair['worse']} episodes"
         )
     if paired:
         lines.append(f"paired: episode by episode on the same start states; ties within {TIE_DAYS} day")

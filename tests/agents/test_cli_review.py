@@ -3,6 +3,8 @@
 Each test failed before its fix.
 """
 
+import json
+
 import pytest
 
 from orbit_env.cli import main
@@ -59,3 +61,39 @@ def test_train_names_its_arguments_as_the_caller_gave_them(tmp_path):
     with pytest.raises(ValueError, match=r"^env_id='Nope-v0' is not an orbit_env environment"):
         train(out_dir=tmp_path / "run", env_id="Nope-v0", progress=False)
     assert not (tmp_path / "run").exists()
+
+
+# --------------------------------------------------------------------------------------
+# No NaN in what the commands write: an undefined number is JSON null
+# --------------------------------------------------------------------------------------
+
+
+def strict_json(text: str):
+    """JSON as a strict parser reads it: NaN and Infinity are not JSON."""
+
+    def refused(constant):
+        raise AssertionError(f"{constant} in the JSON: {text[:200]}")
+
+    return json.loads(text, parse_constant=refused)
+
+
+def test_one_episode_has_no_standard_error_json_null_and_said_in_the_table(capsys):
+    assert main(["evaluate", "--no-dp", "--episodes", "1", "--json"]) == 0
+    paired = strict_json(capsys.readouterr().out)["paired_difference"]
+    assert paired["stderr"] is None and paired["mean"] == pytest.approx(paired["mean"])
+    assert main(["evaluate", "--no-dp", "--episodes", "1"]) == 0
+    table = capsys.readouterr().out
+    assert "nan" not in table and "(one episode: no standard error)" in table
+
+
+def test_a_curve_point_without_a_capture_is_null_not_nan():
+    from orbit_env.agents.curves import aggregate, format_curves
+
+    # Never burning as good as the DP on the episodes: no capture at that point, for any run.
+    runs = [{"algo": "ppo", "seed": s, "points": [[0, 1.0, None], [128, 1.0, 0.5]], "wall_s": 1.0} for s in (0, 1)]
+    curve = aggregate(runs)["ppo"]
+    assert curve["iqm_capture"][0] is curve["ci95_low"][0] is curve["ci95_high"][0] is None
+    assert curve["iqm_capture"][1] == pytest.approx(0.5)
+    strict_json(json.dumps({"curves": {"ppo": curve}}))
+    text = format_curves({"env": "OrbitRaising-v0", "episodes": 2, "eval_seed": 1, "curves": {"ppo": curve}})
+    assert "nan" not in text and "no capture" in text
