@@ -11,6 +11,7 @@ output with the default file::
 from __future__ import annotations
 
 import json
+import math
 import re
 import time
 import tomllib
@@ -100,8 +101,56 @@ POLICY_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {
 NORMALIZE_KEYS: dict[str, tuple[type | tuple[type, ...], Any]] = {"reward": (bool, False)}
 #: The policy network's activations by name.
 ACTIVATIONS = ("tanh", "relu", "elu", "gelu", "leaky_relu")
-#: PPO's constructor arguments a config may not set: the command sets them.
-_PPO_RESERVED = ("self", "policy", "env", "tensorboard_log", "policy_kwargs", "verbose", "seed", "device")
+#: PPO's constructor arguments a config may not set: the command sets them, or (a class and its arguments, which
+#: the algorithm's own would repeat) TOML cannot give them.
+_PPO_RESERVED = (
+    "self",
+    "policy",
+    "env",
+    "tensorboard_log",
+    "policy_kwargs",
+    "verbose",
+    "seed",
+    "device",
+    "rollout_buffer_class",
+    "rollout_buffer_kwargs",
+)
+#: The largest seed: NumPy's legacy generator, which Stable-Baselines3 seeds, takes 0 to 2**32 - 1.
+MAX_SEED = 2**32 - 1
+#: The largest initial logit or mean: the network's float32 holds 3.4e38, and the bias adds both.
+_MAX_INITIAL = 1e38
+#: Every number of a training config (a table's as ``table.key``) and what it may be, besides finite: (test, allowed).
+#: The bounds are those Stable-Baselines3 and torch take, or those within which the value means what its name says
+#: (a negative clip range trains without an error, on a clip inverted).
+NUMBER_RANGES: dict[str, tuple[Callable[[float], bool], str]] = {
+    "seed": (lambda x: 0 <= x <= MAX_SEED, f"an integer from 0 to {MAX_SEED} (NumPy's seeds)"),
+    "num_envs": (lambda x: x >= 1, "an integer >= 1"),
+    "total_timesteps": (lambda x: x >= 1, "an integer >= 1"),
+    "checkpoint_every": (lambda x: x >= 0, "an integer >= 0 (0: none)"),
+    "eval_every": (lambda x: x >= 0, "an integer >= 0 (0: none)"),
+    "eval_episodes": (lambda x: x >= 1, "an integer >= 1"),
+    "end_decided": (lambda x: 0 <= x <= 1, "a probability in [0, 1]"),
+    "learning_rate_decay_start": (lambda x: 0 <= x < 1, "a fraction in [0, 1)"),
+    "ppo.learning_rate": (lambda x: x > 0, "a number > 0"),
+    "ppo.n_steps": (lambda x: x >= 1, "an integer >= 1"),
+    "ppo.batch_size": (lambda x: x >= 1, "an integer >= 1"),
+    "ppo.n_epochs": (lambda x: x >= 1, "an integer >= 1"),
+    "ppo.gamma": (lambda x: 0 <= x <= 1, "a number in [0, 1]"),
+    "ppo.gae_lambda": (lambda x: 0 <= x <= 1, "a number in [0, 1]"),
+    "ppo.clip_range": (lambda x: x > 0, "a number > 0 (the ratio is clipped to 1 - clip_range, 1 + clip_range)"),
+    "ppo.clip_range_vf": (lambda x: x > 0, "a number > 0 (leave the key out: the value is not clipped)"),
+    "ppo.ent_coef": (lambda x: x >= 0, "a number >= 0"),
+    "ppo.vf_coef": (lambda x: x >= 0, "a number >= 0"),
+    "ppo.max_grad_norm": (lambda x: x > 0, "a number > 0"),
+    "ppo.target_kl": (lambda x: x > 0, "a number > 0 (leave the key out: no early stop)"),
+    "ppo.sde_sample_freq": (lambda x: x >= -1, "an integer >= -1 (-1: new noise at each rollout only)"),
+    "ppo.stats_window_size": (lambda x: x >= 1, "an integer >= 1"),
+    "policy.initial_coast_logit": (lambda x: abs(x) <= _MAX_INITIAL, "a number from -1e38 to 1e38 (float32)"),
+    "policy.initial_action_mean": (lambda x: abs(x) <= _MAX_INITIAL, "a number from -1e38 to 1e38 (float32)"),
+    # Stable-Baselines3's bounds of a Gaussian policy's log std (sac/policies.py LOG_STD_MIN, LOG_STD_MAX): beyond
+    # them PPO's Gaussian overflows float32 in training.
+    "policy.log_std_init": (lambda x: -20 <= x <= 2, "a number in [-20, 2] (Stable-Baselines3's log std bounds)"),
+}
 
 
 def _type_name(kind: type | tuple[type, ...]) -> str:
@@ -144,8 +193,8 @@ def _ppo_schema() -> dict[str, tuple[type | tuple[type, ...], Any]]:
             kind: type | tuple[type, ...] = bool
         elif isinstance(default, (int, float)):
             kind = (int, float) if isinstance(default, float) or name in ("learning_rate", "clip_range") else int
-        else:  # None: a number or a table (clip_range_vf, target_kl, rollout_buffer_kwargs)
-            kind = (int, float, dict, str)
+        else:  # None: off, or a number (clip_range_vf, target_kl)
+            kind = (int, float)
         schema[name] = (kind, "absent")
     return schema
 
@@ -206,38 +255,33 @@ def _check_overrides(overrides: dict[str, Any]) -> None:
         if overrides[key] is not None:
             check_int(overrides[key], key, low=1)
     if overrides["seed"] is not None:
-        check_int(overrides["seed"], "seed", low=0)
+        check_int(overrides["seed"], "seed", low=0, high=MAX_SEED)
     if overrides["env_id"] is not None:
         check_trainable(overrides["env_id"], f"env_id={overrides['env_id']!r}")
 
 
 def _check_values(config: dict[str, Any], source: str) -> None:
-    """The values' ranges and the combinations that cannot work (ValueError naming the key)."""
+    """The values' ranges and the combinations that cannot work (ValueError naming the key).
+
+    Every number against `NUMBER_RANGES`, so that nothing that passes fails in Stable-Baselines3 or torch
+    after the run's folder is written (its asserts, a NaN in the network) or trains on a value that means
+    nothing.
+    """
     from orbit_env.envs import SOLAR_ENV_IDS
 
     check_trainable(config["env_id"], f"{source}: env_id = {config['env_id']!r}")
-    for key in ("seed", "checkpoint_every", "eval_every"):
-        if config[key] < 0:
-            raise ValueError(f"{source}: {key} = {config[key]} is invalid; allowed: an integer >= 0")
-    for key in ("num_envs", "total_timesteps", "eval_episodes"):
-        if config[key] <= 0:
-            raise ValueError(f"{source}: {key} = {config[key]} is invalid; allowed: an integer >= 1")
+    for key, (allowed, text) in NUMBER_RANGES.items():
+        table, _, name = key.rpartition(".")
+        values = config[table] if table else config
+        if name in values and not (math.isfinite(values[name]) and allowed(values[name])):
+            raise ValueError(f"{source}: {key} = {values[name]!r} is invalid; allowed: {text}")
     if config["learning_rate_schedule"] not in ("constant", "linear"):
         raise ValueError(
             f"{source}: learning_rate_schedule = {config['learning_rate_schedule']!r} is invalid; "
             "allowed: constant, linear"
         )
-    if not 0.0 <= config["learning_rate_decay_start"] < 1.0:
-        raise ValueError(
-            f"{source}: learning_rate_decay_start={config['learning_rate_decay_start']!r} is invalid; "
-            "allowed: a fraction in [0, 1)"
-        )
     if config["shaping"] not in SHAPINGS:
-        raise ValueError(f"{source}: shaping={config['shaping']!r} is invalid; allowed: {', '.join(SHAPINGS)}")
-    if not 0.0 <= config["end_decided"] <= 1.0:
-        raise ValueError(
-            f"{source}: end_decided={config['end_decided']!r} is invalid; allowed: a probability in [0, 1]"
-        )
+        raise ValueError(f"{source}: shaping = {config['shaping']!r} is invalid; allowed: {', '.join(SHAPINGS)}")
     if config["env_id"] in SOLAR_ENV_IDS and config["shaping"] != "none":
         raise ValueError(
             f'{source}: shaping = {config["shaping"]!r} is invalid for {config["env_id"]}; allowed: "none" '
@@ -256,27 +300,37 @@ def _check_values(config: dict[str, Any], source: str) -> None:
     if not arch or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in arch):
         raise ValueError(f"{source}: policy.net_arch = {arch!r} is invalid; allowed: a list of layer widths >= 1")
     ppo = config["ppo"]
-    for key in ("n_steps", "batch_size", "n_epochs"):
-        if key in ppo and ppo[key] < 1:
-            raise ValueError(f"{source}: ppo.{key} = {ppo[key]} is invalid; allowed: an integer >= 1")
-    for key in ("gamma", "gae_lambda"):
-        if key in ppo and not 0.0 <= ppo[key] <= 1.0:
-            raise ValueError(f"{source}: ppo.{key} = {ppo[key]} is invalid; allowed: a number in [0, 1]")
-    if "learning_rate" in ppo and not ppo["learning_rate"] > 0.0:
-        raise ValueError(f"{source}: ppo.learning_rate = {ppo['learning_rate']} is invalid; allowed: a number > 0")
-    _check_env_keywords(config["env_id"], config["env"], source)
+    if ppo.get("normalize_advantage", True):  # PPO's asserts: the advantages are normalized over a batch
+        if ppo.get("batch_size", 64) < 2:
+            raise ValueError(
+                f"{source}: ppo.batch_size = {ppo['batch_size']} is invalid; allowed: an integer >= 2 "
+                "(the advantages are normalized over a batch; or normalize_advantage = false)"
+            )
+        if rollout_size(config) < 2:
+            raise ValueError(
+                f"{source}: ppo.n_steps x num_envs = {rollout_size(config)} is invalid; allowed: at least 2 "
+                "(the advantages are normalized over a rollout; or normalize_advantage = false)"
+            )
+    continuous = _check_env_keywords(config["env_id"], config["env"], source)
+    if ppo.get("use_sde") and not continuous:
+        raise ValueError(
+            f"{source}: ppo.use_sde = true is invalid for {config['env_id']}; allowed: false "
+            "(state-dependent exploration is for continuous actions)"
+        )
 
 
-def _check_env_keywords(env_id: str, keywords: dict[str, Any], source: str) -> None:
-    """The ``[env]`` table makes the environment (ValueError naming the bad keyword)."""
+def _check_env_keywords(env_id: str, keywords: dict[str, Any], source: str) -> bool:
+    """The ``[env]`` table makes the environment (ValueError naming the bad keyword); whether its actions are a Box."""
     import gymnasium
 
     import orbit_env  # noqa: F401  (registers the environments)
 
     try:
-        gymnasium.make(env_id, **keywords).close()
+        env = gymnasium.make(env_id, **keywords)
     except ValueError as error:
         raise ValueError(f"{source}: [env] {error}") from None
+    env.close()
+    return isinstance(env.action_space, gymnasium.spaces.Box)
 
 
 def linear_decay(rate: float, start: float = 0.0) -> Callable[[float], float]:
@@ -648,7 +702,7 @@ def train(
             venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=gamma)
     if checkpoint is not None:
         model = PPO.load(checkpoint, env=venv, device="cpu", tensorboard_log=str(out / "tensorboard"))
-        model.set_random_seed(seed + int(model.num_timesteps))
+        model.set_random_seed((seed + int(model.num_timesteps)) % (MAX_SEED + 1))
     else:
         model = _new_model(PPO, torch, config, venv, out)
     model.orbit_env = {"env_id": config["env_id"], "env": dict(config["env"])}  # saved with the model

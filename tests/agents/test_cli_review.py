@@ -4,6 +4,7 @@ Each test failed before its fix.
 """
 
 import json
+import re
 
 import pytest
 
@@ -41,7 +42,7 @@ def test_the_api_refuses_a_negative_seed_naming_it():
 @pytest.mark.parametrize(
     ("flags", "message"),
     [
-        (["--seed", "-1"], "--seed -1 is out of range; allowed: an integer at least 0"),
+        (["--seed", "-1"], "--seed -1 is out of range; allowed: an integer 0 to 4294967295"),
         (["--env", "Nope-v0"], "--env Nope-v0 is not an orbit_env environment; allowed: OrbitRaising-v0"),
     ],
 )
@@ -97,3 +98,73 @@ def test_a_curve_point_without_a_capture_is_null_not_nan():
     strict_json(json.dumps({"curves": {"ppo": curve}}))
     text = format_curves({"env": "OrbitRaising-v0", "episodes": 2, "eval_seed": 1, "curves": {"ppo": curve}})
     assert "nan" not in text and "no capture" in text
+
+
+# --------------------------------------------------------------------------------------
+# train: every number of the config checked before anything is written to --out
+# --------------------------------------------------------------------------------------
+
+TINY = """\
+env_id = "OrbitRaising-v0"
+seed = 0
+num_envs = 8
+total_timesteps = 100
+shaping = "none"
+[env]
+horizon_steps = 30
+[ppo]
+n_steps = 16
+batch_size = 64
+n_epochs = 1
+[policy]
+net_arch = [16]
+initial_coast_logit = 2.0
+"""
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # Stable-Baselines3's AssertionError, in a traceback
+        ("batch_size = 64", "batch_size = 1", r"ppo\.batch_size = 1 is invalid; allowed: an integer >= 2"),
+        ("num_envs = 8", "num_envs = 1", None),  # with n_steps = 1 below
+        # torch's "Expected parameter logits ... found invalid values", after config.json and tensorboard/
+        ("initial_coast_logit = 2.0", "initial_coast_logit = nan", r"policy\.initial_coast_logit = nan is invalid"),
+        # trained on, without an error
+        ("n_epochs = 1", "n_epochs = 1\nclip_range = -0.2", r"ppo\.clip_range = -0\.2 is invalid"),
+        ("n_epochs = 1", "n_epochs = 1\nmax_grad_norm = -1.0", r"ppo\.max_grad_norm = -1\.0 is invalid"),
+        ("n_epochs = 1", "n_epochs = 1\nent_coef = -0.1", r"ppo\.ent_coef = -0\.1 is invalid"),
+        ("n_epochs = 1", "n_epochs = 1\nlearning_rate = inf", r"ppo\.learning_rate = inf is invalid"),
+        ("n_epochs = 1", "n_epochs = 1\ntarget_kl = 'x'", r"ppo\.target_kl = 'x' is invalid; allowed: a number"),
+        ("n_epochs = 1", "n_epochs = 1\nuse_sde = true", r"ppo\.use_sde = true is invalid for OrbitRaising-v0"),
+        ("n_epochs = 1", "n_epochs = 1\nrollout_buffer_kwargs = {}", r"unknown key ppo\.'rollout_buffer_kwargs'"),
+        ("initial_coast_logit = 2.0", "log_std_init = -100.0", r"policy\.log_std_init = -100\.0 is invalid"),
+        ("seed = 0", "seed = 4294967296", r"seed = 4294967296 is invalid; allowed: an integer from 0 to 4294967295"),
+    ],
+)
+def test_train_refuses_a_config_number_that_would_fail_or_mislead_before_writing_anything(
+    tmp_path, capsys, old, new, message
+):
+    text = TINY.replace(old, new)
+    if message is None:
+        text = text.replace("n_steps = 16", "n_steps = 1")
+        message = r"ppo\.n_steps x num_envs = 1 is invalid; allowed: at least 2"
+    assert old in TINY and text != TINY
+    config = tmp_path / "my.toml"
+    config.write_text(text)
+    out = tmp_path / "run"
+    assert main(["train", "--config", str(config), "--out", str(out), "--no-progress"]) == 2
+    err = one_line_error(capsys)
+    assert re.search(message, err) and err.startswith(f"orbit-env: error: {config}: ")
+    assert not out.exists()  # no config.json, no tensorboard/
+
+
+def test_every_number_of_a_training_config_has_its_range():
+    from orbit_env.agents.train import NUMBER_RANGES, POLICY_KEYS, TOP_KEYS, _ppo_schema
+
+    def numbers(schema, table=""):
+        kinds = {key: kind if isinstance(kind, tuple) else (kind,) for key, (kind, _) in schema.items()}
+        return {table + key for key, kind in kinds.items() if int in kind or float in kind}
+
+    every = numbers(TOP_KEYS) | numbers(_ppo_schema(), "ppo.") | numbers(POLICY_KEYS, "policy.")
+    assert every == set(NUMBER_RANGES)

@@ -36,9 +36,9 @@ def test_linear_decay_holds_the_rate_then_falls_to_zero():
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        ('shaping = "never_burn_value"\nend_decided = 1.5', "end_decided=1.5 is invalid"),
+        ('shaping = "never_burn_value"\nend_decided = 1.5', "end_decided = 1.5 is invalid"),
         ("end_decided = 0.5", 'end_decided > 0 needs shaping = "never_burn_value"'),
-        ("learning_rate_decay_start = 1.0", "learning_rate_decay_start=1.0 is invalid"),
+        ("learning_rate_decay_start = 1.0", "learning_rate_decay_start = 1.0 is invalid"),
     ],
 )
 def test_training_config_checks_name_the_bad_value(tmp_path, extra, message):
