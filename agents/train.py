@@ -356,7 +356,8 @@ def timesteps_to_train(requested: int, config: dict[str, Any]) -> int:
 class BestModelCallback(BaseCallback):
     """Score the policy on the same seeded episodes of the plain environment; keep the best model.
 
-    Every ``every_calls`` steps of the vector env it plays one episode per
+    At the first rollout boundary at or past every ``every_calls`` steps of the vector env
+    (`due_between_rollouts`), and at the end through `train`, it plays one episode per
     sub-environment of ``gymnasium.make_vec(env_id, num_envs=episodes, **env_kwargs)``
     seeded with ``seed`` (`orbit_env.agents.evaluate.run_episodes`: the
     unshaped reward, deterministic actions; on the solar task the missions of
@@ -420,9 +421,12 @@ class BestModelCallback(BaseCallback):
         return self.save_dir / "best_model.zip"
 
     def _on_step(self) -> bool:
-        if self.n_calls % self.every_calls == 0:
-            self.evaluate()
         return True
+
+    def _on_rollout_start(self) -> None:
+        last = self.evaluations[-1]["timesteps"] if self.evaluations else 0
+        if due_between_rollouts(last, self.model.num_timesteps, self.every_calls * self.model.n_envs):
+            self.evaluate()
 
     def evaluate(self) -> float:
         """Score the current policy now; save it if it is the best so far; return its mean return."""
@@ -554,18 +558,49 @@ def save_checkpoint(model: Any, folder: Path, timesteps: int) -> Path:
     return path
 
 
+def due_between_rollouts(last: int, now: int, every: int) -> bool:
+    """Whether a periodic callback acts at ``now`` timesteps, called between rollouts, having acted at ``last``.
+
+    It acts at the first rollout boundary at or past each multiple of ``every`` timesteps. Between rollouts the
+    policy has been updated on every timestep counted, so a checkpoint or a score taken there is of the policy
+    its step count names. Taken on a step inside a rollout, as SB3's ``CheckpointCallback`` and ``EvalCallback``
+    take them, it would be of a policy not yet updated on up to a rollout's steps (10M with 20000 satellites),
+    and a run resumed from such a checkpoint would skip them.
+    """
+    every = max(int(every), 1)
+    return now >= (last // every + 1) * every
+
+
 class CheckpointEvery(BaseCallback):
-    """`save_checkpoint` every ``every_calls`` environment steps (SB3's CheckpointCallback, its files whole)."""
+    """`save_checkpoint` every ``every_calls`` steps of the vector env, between rollouts, and at the end.
+
+    SB3's CheckpointCallback, its files whole and taken where the policy is the one their names count
+    (`due_between_rollouts`).
+    """
 
     def __init__(self, every_calls: int, folder: Path) -> None:
         super().__init__(verbose=0)
         self.every_calls = max(int(every_calls), 1)
         self.folder = folder
+        self.last = 0
+
+    def _on_training_start(self) -> None:
+        self.last = int(self.model.num_timesteps)  # a resumed run's checkpoint is there already
 
     def _on_step(self) -> bool:
-        if self.n_calls % self.every_calls == 0:
-            save_checkpoint(self.model, self.folder, int(self.model.num_timesteps))
         return True
+
+    def _on_rollout_start(self) -> None:
+        self._save_when_due()
+
+    def _on_training_end(self) -> None:  # after the last update
+        self._save_when_due()
+
+    def _save_when_due(self) -> None:
+        now = int(self.model.num_timesteps)
+        if due_between_rollouts(self.last, now, self.every_calls * self.model.n_envs):
+            save_checkpoint(self.model, self.folder, now)
+            self.last = now
 
 
 def newest_checkpoint(out_dir: str | Path) -> Path | None:
@@ -742,6 +777,7 @@ def train(
                 model.set_logger(configure_logger(None, []))
                 best.init_callback(model)
             best.evaluate()  # the final policy competes too
+            model.logger.dump(model.num_timesteps)  # learn has written its last logs: its score to tensorboard
         seconds = time.perf_counter() - start
         _save_whole(model, model_path)
     except KeyboardInterrupt:

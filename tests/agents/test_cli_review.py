@@ -8,6 +8,13 @@ import re
 
 import pytest
 
+pytest.importorskip("stable_baselines3")
+
+import torch
+from stable_baselines3 import PPO
+from stable_baselines3.common.callbacks import BaseCallback
+
+from orbit_env.agents.train import TrainingInterrupted, newest_checkpoint, train
 from orbit_env.cli import main
 
 
@@ -55,8 +62,6 @@ def test_train_blames_a_flags_value_on_the_flag_not_on_the_config_file(tmp_path,
 
 
 def test_train_names_its_arguments_as_the_caller_gave_them(tmp_path):
-    from orbit_env.agents.train import train
-
     with pytest.raises(ValueError, match=r"^seed=-1 is out of range"):
         train(out_dir=tmp_path / "run", seed=-1, progress=False)
     with pytest.raises(ValueError, match=r"^env_id='Nope-v0' is not an orbit_env environment"):
@@ -168,3 +173,63 @@ def test_every_number_of_a_training_config_has_its_range():
 
     every = numbers(TOP_KEYS) | numbers(_ppo_schema(), "ppo.") | numbers(POLICY_KEYS, "policy.")
     assert every == set(NUMBER_RANGES)
+
+
+# --------------------------------------------------------------------------------------
+# train: a checkpoint named N holds the policy trained on N timesteps
+# --------------------------------------------------------------------------------------
+
+
+class StopAt(BaseCallback):
+    """Ctrl-C at the ``calls``-th vector step (16 make a rollout of 128 timesteps in `TINY`)."""
+
+    def __init__(self, calls: int) -> None:
+        super().__init__()
+        self.calls = calls
+
+    def _on_step(self) -> bool:
+        if self.n_calls == self.calls:
+            raise KeyboardInterrupt
+        return True
+
+
+def policy_of(path):
+    """A saved model's policy parameters."""
+    return PPO.load(path, device="cpu").policy.state_dict()
+
+
+def test_checkpoints_are_taken_between_rollouts_and_named_by_the_steps_learned(tmp_path):
+    # Checkpoints every 64 timesteps in rollouts of 128: SB3's way had saved inside a rollout, a policy not
+    # updated on the steps its name counted (a kill at 20 s of a 10M-step rollout left rl_model_4000000 of
+    # an untrained policy, which the next command offered to resume, skipping 4M steps of training).
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY.replace("shaping", "checkpoint_every = 64\nshaping"))
+    out = tmp_path / "run"
+    train(config, out, total_timesteps=256, progress=False)
+    names = sorted(p.name for p in (out / "checkpoints").glob("rl_model_*_steps.zip"))
+    assert names == ["rl_model_128_steps.zip", "rl_model_256_steps.zip"]
+    # The checkpoint at 128 is the policy after the first update: a run of 128 steps ends with it.
+    one = train(config, tmp_path / "one", total_timesteps=128, progress=False)
+    after_one, checkpoint = policy_of(one.model_path), policy_of(out / "checkpoints" / "rl_model_128_steps.zip")
+    assert all(torch.equal(after_one[key], checkpoint[key]) for key in after_one)
+    final, last = policy_of(out / "model.zip"), policy_of(out / "checkpoints" / "rl_model_256_steps.zip")
+    assert all(torch.equal(final[key], last[key]) for key in final)
+    # Stopped inside its first rollout, the run keeps step 0, and that is what the next command offers to resume.
+    stopped = tmp_path / "stopped"
+    with pytest.raises(TrainingInterrupted) as stop:
+        train(config, stopped, total_timesteps=256, progress=False, extra_callbacks=[StopAt(12)])
+    assert stop.value.timesteps == 0 and newest_checkpoint(stopped) == stop.value.checkpoint
+    with pytest.raises(ValueError, match=r"continue it with --resume .*rl_model_0_steps\.zip"):
+        train(config, stopped, total_timesteps=256, progress=False)
+
+
+def test_validation_scores_the_policy_updated_on_the_steps_it_is_labelled_with(tmp_path):
+    # Scored every 128 timesteps in rollouts of 128: the score at 128 had been taken at the rollout's last step,
+    # before the update, and the final policy was then not scored (its label, 128, was taken).
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY.replace("shaping", "eval_every = 128\neval_episodes = 4\nshaping"))
+    out = tmp_path / "run"
+    train(config, out, total_timesteps=128, progress=False)
+    assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128]
+    final, best = policy_of(out / "model.zip"), policy_of(out / "best_model.zip")  # the one score's model
+    assert all(torch.equal(final[key], best[key]) for key in final)
