@@ -52,6 +52,12 @@ from orbit_env.physics.orbit import elements_from_heights, period_s
 FloatArray = NDArray[np.float64]
 
 
+#: A re-entry fit's uncertainties unless told: of the re-entry time [days] (a day-only date is +-0.5 day) and of
+#: the first orbit's heights [km].
+REENTRY_SIGMA_DAYS = 0.5
+HEIGHT_SIGMA_KM = 1.0
+
+
 @dataclass(frozen=True)
 class Observations:
     """Observed orbits: time [days], perigee and apogee heights [km].
@@ -245,8 +251,8 @@ def fit_density_scale(
     scenario: Scenario,
     inclination_deg: float = 0.0,
     reentry: str | float | None = None,
-    reentry_sigma_days: float = 0.5,
-    height_sigma_km: float = 1.0,
+    reentry_sigma_days: float = REENTRY_SIGMA_DAYS,
+    height_sigma_km: float = HEIGHT_SIGMA_KM,
 ) -> DensityFit:
     """Estimate the density scale factor s of ``scenario`` from an observed decay.
 

@@ -131,6 +131,11 @@ def drag_source(
     """
     if inputs.shape is None and inputs.diameter_m is not None:
         raise ValueError("--diameter-m goes with --shape sphere")
+    if inputs.given and inputs.drag_from is not None:
+        raise ValueError(
+            "--drag-from chooses what an element set's drag is read from; the satellite given (--mass, --area, "
+            "--shape) flies its own drag instead: drop one of them"
+        )
     cx = PAPER_DRAG_COEFFICIENT if inputs.drag_coefficient is None else inputs.drag_coefficient
     if inputs.shape is not None:
         if inputs.diameter_m is None:

@@ -40,6 +40,11 @@ from orbit_env.physics.orbit import MAX_APOGEE_M
 REFERENCE = "equatorial"
 
 
+def _km(value: float, decimals: int) -> str:
+    """A distance in km to ``decimals`` places, or in four digits beyond any orbit (not 300 digits of 1e300)."""
+    return f"{value:.{decimals}f}" if abs(value) < 1e7 else f"{value:.4g}"
+
+
 def check_flown(elements: ElementSet, given: str = "the element set") -> None:
     """An orbit from mean elements that the decay can start from, or an error in the elements' own terms.
 
@@ -52,8 +57,8 @@ def check_flown(elements: ElementSet, given: str = "the element set") -> None:
     shift = offset_km(REFERENCE)
     perigee, apogee = elements.flown_perigee_km, elements.flown_apogee_km
     where = (
-        f"{given} (a = {elements.semi_major_axis_km:.3f} km, e = {elements.eccentricity:.7f}) is flown at "
-        f"{perigee:.1f} x {apogee:.1f} km above the equatorial radius"
+        f"{given} (a = {_km(elements.semi_major_axis_km, 3)} km, e = {elements.eccentricity:.7f}) is flown at "
+        f"{_km(perigee, 1)} x {_km(apogee, 1)} km above the equatorial radius"
     )
     reentry_km = REENTRY_ALTITUDE_M / 1e3 - shift
     if not perigee >= 0.0:

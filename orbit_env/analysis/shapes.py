@@ -21,6 +21,7 @@ import numpy as np
 from orbit_env.physics.atmosphere.msis import geodetic_altitude_m, orbit_samples, require_pymsis
 from orbit_env.physics.drag import WALL_TEMPERATURE_K, panel_drag_area_m2, speed_ratio, sphere_drag_coefficient
 from orbit_env.physics.orbit import air_speed_at_perigee_m_s, perigee_velocity_m_s
+from orbit_env.physics.satellite_bounds import AREA_RANGE_M2
 
 #: Energy accommodation of the drag model (Sentman's diffuse, fully accommodated re-emission).
 ACCOMMODATION = 1.0
@@ -61,7 +62,9 @@ def sphere(diameter_m: float) -> Shape:
     """A sphere of this diameter."""
     from orbit_env.checks import check_number
 
-    d = check_number(diameter_m, "diameter_m", unit="m", low=0.0, low_inclusive=False)
+    largest = math.floor(20.0 * math.sqrt(AREA_RANGE_M2[1] / math.pi)) / 10.0  # 356.8 m
+    why = f"a cross-section of at most {AREA_RANGE_M2[1]:g} m^2"
+    d = check_number(diameter_m, "diameter_m", unit="m", low=0.0, low_inclusive=False, high=largest, why=why)
     return Shape(math.pi * d**2 / 4.0, sphere=True)
 
 

@@ -109,6 +109,13 @@ def check_figure(path: str, option: str, inputs: Sequence[tuple[str, str | None]
         raise ImportError(f"{option} needs matplotlib: pip install 'orbit-env[plot]'") from error
 
     formats = sorted(FigureCanvasBase.get_supported_filetypes())
+    if "pgf" in formats:  # matplotlib writes PGF through a LaTeX it runs: offered where there is one
+        import shutil
+
+        from matplotlib import rcParams
+
+        if shutil.which(rcParams["pgf.texsystem"]) is None:
+            formats.remove("pgf")
     suffix = Path(path).suffix.lower().lstrip(".")
     if suffix not in formats:
         raise ValueError(
@@ -179,6 +186,8 @@ FLAGS: dict[str, tuple[str, float, str | None]] = {
 
 def in_flags(error: InputError, args: argparse.Namespace) -> str:
     """The error in the command line's words: the flag, the value as typed, the flag's unit."""
+    if error.name == "mass_kg / area_m2" and error.index is None and given(args, "mass") and given(args, "area"):
+        return error.message("--mass / --area")  # G/F of the two flags, in their units
     if error.name not in FLAGS or error.index is not None or not hasattr(args, FLAGS[error.name][0]):
         return str(error)  # not a flag's value (a file's cell, an element of a table)
     dest, factor, unit = FLAGS[error.name]
@@ -211,6 +220,18 @@ def _height_shift_km(error: InputError, args: argparse.Namespace, typed: Any) ->
     except (TypeError, ValueError):
         return 0.0
     return -offset if offset and checked_sphere else 0.0
+
+
+def output_file(text: str) -> str:
+    """The argparse type of a file to write: a name, not an empty one nor ``-`` (no output goes to stdout)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty file name; give one")
+    if text.strip() == "-":
+        raise argparse.ArgumentTypeError("'-' (standard output) is not written to; give a file name")
+    return text
+
+
+output_file.__name__ = "file name"  # argparse says "invalid file name value: ..." if it ever falls through
 
 
 def positive_int(text: str) -> int:

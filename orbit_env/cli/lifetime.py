@@ -19,6 +19,7 @@ import numpy as np
 
 from orbit_env.analysis.air import AIR_MODELS, DATED_AIR, DEFAULT_AIR, air_model
 from orbit_env.analysis.air.msis import DEFAULT_ACTIVITY, MSIS_VERSION_CHOICES
+from orbit_env.analysis.density_fit import HEIGHT_SIGMA_KM, REENTRY_SIGMA_DAYS
 from orbit_env.analysis.drag_source import SOURCE_DEFAULT, SOURCE_SATELLITE, DragSource, drag_sigma
 from orbit_env.analysis.lifetime import (
     METHODS,
@@ -39,6 +40,7 @@ from orbit_env.cli.common import (
     flag,
     given,
     number,
+    output_file,
     positive_int,
     write_csv,
 )
@@ -69,6 +71,13 @@ def _scenario(args: argparse.Namespace) -> Scenario:
     scenario = Scenario(air, args.density_scale, rotating, chunk_days)
     if args.chunk_days is not None and scenario.epoch_days is None:
         raise ValueError("--chunk-days is the time step of a dated decay: it goes with --epoch (or an element set's)")
+    if getattr(args, "inclination_typed", False) and not scenario.depends_on_inclination:
+        raise ValueError(
+            f"--inclination changes nothing under --atmosphere {args.atmosphere} (still air, the same at every "
+            "latitude); it goes with --atmosphere msis or --rotating-atmosphere"
+        )
+    if getattr(args, "daily_ap", False) and scenario.epoch_days is None:
+        raise ValueError("--daily-ap chooses a dated decay's Ap: it goes with --epoch (or an element set's)")
     table, epoch = scenario.activity, scenario.epoch_days
     if isinstance(table, TableActivity) and epoch is not None and epoch > table.end_days + 1.0:
         raise ValueError(
@@ -170,6 +179,7 @@ def _input_files(args: argparse.Namespace) -> list[tuple[str, str | None]]:
 
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
+    args.inclination_typed = args.inclination is not None
     _check_inclination(args)
     if args.trajectory and not args.batch:
         check_output(args.trajectory, "--trajectory", _input_files(args))
@@ -290,6 +300,8 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
         raise ValueError("--batch needs --out CSV for the results")
     if args.perigee is not None or args.apogee is not None:
         raise ValueError("--batch reads the orbits from the file; do not give --perigee/--apogee")
+    if args.semi_major_axis_km is not None or args.eccentricity is not None:
+        raise ValueError("--batch reads the orbits from the file; do not give --semi-major-axis-km/--eccentricity")
     for name in ("trajectory", "plot", "json"):
         if given(args, name):
             raise ValueError(f"{flag(name)} applies to a single lifetime, not to --batch")
@@ -351,6 +363,7 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     from orbit_env.analysis.density_fit import fit_density_scale, read_observations, reentry_days
 
     args.inclination_defaulted = args.inclination is None
+    args.inclination_typed = args.inclination is not None
     _check_inclination(args)
     if args.inclination is None:
         args.inclination = 0.0
@@ -372,14 +385,17 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     satellite = _satellite(args)
     scenario = _scenario(args)
     reentry = None if args.reentry is None else reentry_days(args.reentry, observations, "--reentry")
+    for name in ("reentry_sigma_days", "height_sigma_km"):
+        if reentry is None and given(args, name):
+            raise ValueError(f"{flag(name)} is an uncertainty of a fit to a re-entry: it goes with --reentry")
     fit = fit_density_scale(
         observations,
         satellite=satellite,
         scenario=scenario,
         inclination_deg=args.inclination,
         reentry=reentry,
-        reentry_sigma_days=args.reentry_sigma_days,
-        height_sigma_km=args.height_sigma_km,
+        reentry_sigma_days=REENTRY_SIGMA_DAYS if args.reentry_sigma_days is None else args.reentry_sigma_days,
+        height_sigma_km=HEIGHT_SIGMA_KM if args.height_sigma_km is None else args.height_sigma_km,
     )
     if scenario.epoch_days is not None:  # the decay runs to the re-entry, or to the last observation
         last = float(observations.days[-1]) if reentry is None else reentry
@@ -504,7 +520,7 @@ def add_parsers(sub: Any) -> None:
         help="lifetimes of every orbit in a CSV file, or of every object in a file of element sets (each object's "
         "sets its history; see orbit_env.analysis.catalogue)",
     )
-    life.add_argument("--out", metavar="CSV", help="with --batch: the results file")
+    life.add_argument("--out", type=output_file, metavar="CSV", help="with --batch: the results file")
     life.add_argument(
         "--force",
         action="store_true",
@@ -526,8 +542,8 @@ def add_parsers(sub: Any) -> None:
     )
     orbit_inputs.add_uncertainty_options(life)
     life.add_argument("--json", action="store_true", help="print one JSON object")
-    life.add_argument("--trajectory", metavar="CSV", help="write the decay history to a CSV file")
-    life.add_argument("--plot", metavar="PNG", help="plot the decay history")
+    life.add_argument("--trajectory", type=output_file, metavar="CSV", help="write the decay history to a CSV file")
+    life.add_argument("--plot", type=output_file, metavar="PNG", help="plot the decay history")
     life.set_defaults(func=_cmd_lifetime)
 
     fit = sub.add_parser("fit-density", help="density scale factor from an observed decay (the paper's section 4)")
@@ -538,9 +554,13 @@ def add_parsers(sub: Any) -> None:
         help="observed re-entry, on the observations' time axis (a date, or days with a 'days' column): "
         "fit it from the first orbit",
     )
-    fit.add_argument("--reentry-sigma-days", type=number, default=0.5, help="uncertainty of --reentry (default 0.5)")
     fit.add_argument(
-        "--height-sigma-km", type=number, default=1.0, help="with --reentry: uncertainty of the first orbit's heights"
+        "--reentry-sigma-days", type=number, help=f"with --reentry: its uncertainty (default {REENTRY_SIGMA_DAYS:g})"
+    )
+    fit.add_argument(
+        "--height-sigma-km",
+        type=number,
+        help=f"with --reentry: uncertainty of the first orbit's heights (default {HEIGHT_SIGMA_KM:g})",
     )
     _add_satellite_options(fit)
     _add_atmosphere_options(fit)

@@ -100,7 +100,9 @@ def add_orbit_options(parser: argparse.ArgumentParser) -> None:
 def add_shape_options(group: Any) -> None:
     """``--shape`` and ``--diameter-m`` in the satellite group."""
     group.add_argument(
-        "--shape", choices=("sphere",), help="free-molecular C_D of this shape at the orbit (needs --mass)"
+        "--shape",
+        choices=("sphere",),
+        help="free-molecular C_D of this shape at the orbit (needs --mass; with --cx, the shape gives the area only)",
     )
     group.add_argument("--diameter-m", type=number, metavar="M", help="with --shape sphere: its diameter [m]")
 
@@ -373,8 +375,6 @@ def records_in_reference(records: list[dict[str, Any]], reference: str) -> list[
 
 def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
     """``--uncertainty``, ``--samples``, ``--seed``."""
-    from orbit_env.cli.common import positive_int
-
     group = parser.add_argument_group("uncertainty (orbit_env.analysis.uncertainty)")
     group.add_argument(
         "--uncertainty",
@@ -383,7 +383,7 @@ def add_uncertainty_options(parser: argparse.ArgumentParser) -> None:
         "and with --rule the probability of compliance; with --batch, every row's (seeded by the row), in "
         "chunks over --workers processes, resumed from OUT.parts/ by the same command",
     )
-    group.add_argument("--samples", type=positive_int, help=f"with --uncertainty: samples (default {DEFAULT_SAMPLES})")
+    group.add_argument("--samples", type=int, help=f"with --uncertainty: samples (default {DEFAULT_SAMPLES})")
     group.add_argument("--seed", type=int, help="with --uncertainty: random seed (default 0)")
 
 

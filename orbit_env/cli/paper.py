@@ -8,7 +8,7 @@ import json
 import sys
 from typing import Any
 
-from orbit_env.cli.common import check_figure
+from orbit_env.cli.common import check_figure, output_file
 
 
 def _cmd_table2(args: argparse.Namespace) -> int:
@@ -67,5 +67,7 @@ def add_parsers(sub: Any) -> None:
     table.set_defaults(func=_cmd_table2)
 
     fig = sub.add_parser("fig2", help="draw the paper's Fig. 2")
-    fig.add_argument("--out", default="fig2.png", metavar="PNG", help="output file (default fig2.png)")
+    fig.add_argument(
+        "--out", type=output_file, default="fig2.png", metavar="PNG", help="output file (default fig2.png)"
+    )
     fig.set_defaults(func=_cmd_fig2)

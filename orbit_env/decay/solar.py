@@ -72,10 +72,12 @@ def unix_days(date: str | _dt.date | np.datetime64) -> float:
         if moment.tzinfo is None or moment.utcoffset() is None:
             moment = moment.replace(tzinfo=_dt.UTC)
         return (moment - _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)) / _dt.timedelta(days=1)
-    text = str(date).strip()
+    typed = text = str(date).strip()
     if len(text) == 7 and text[4] == "-":
         text += "-15"  # a month: its middle (monthly tables' values are the month's)
     try:
+        if text.isdigit() and len(text) != 4:  # numpy reads 20200101 as the year 20200101
+            raise ValueError("not a four-digit year")
         if "T" in text and (text.endswith(("Z", "z")) or "+" in text[10:] or "-" in text[10:]):
             moment = _dt.datetime.fromisoformat(text[:-1] + "Z" if text.endswith("z") else text)
             seconds = (moment - _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)).total_seconds()
@@ -83,7 +85,7 @@ def unix_days(date: str | _dt.date | np.datetime64) -> float:
         value = np.datetime64(text, "s")
     except ValueError as error:
         raise ValueError(
-            f"cannot read the date {text!r}; expected YYYY-MM-DD, YYYY-MM or YYYY-MM-DDTHH:MM[:SS] (UTC, or with "
+            f"cannot read the date {typed!r}; expected YYYY-MM-DD, YYYY-MM or YYYY-MM-DDTHH:MM[:SS] (UTC, or with "
             "its zone: Z, +HH:MM)"
         ) from error
     return float(value.astype(np.int64)) / 86400.0

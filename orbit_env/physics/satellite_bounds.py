@@ -25,7 +25,7 @@ AREA_RANGE_M2 = (0.0, 1e5, "a 300 m drag sail; the ISS spans about 2500 m^2")
 MASS_PER_AREA_RANGE_KG_M2 = (
     0.01,
     1e5,
-    "from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2",
+    "ten times beyond a solar sail's 0.1 kg/m^2 and a solid metal body's 1e4 kg/m^2, metres across",
 )
 #: Drag parameter c = c_x F / m [m^2/kg] (Eq. 3.4).
 DRAG_PARAMETER_RANGE_M2_KG = (1e-5, 1e3, "c_x A / m within the bounds of c_x and of mass / area")

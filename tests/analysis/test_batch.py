@@ -168,7 +168,7 @@ def test_batch_rows_with_bad_numbers_name_the_column_and_the_cell(capsys, tmp_pa
         "line 2: mass_kg=0 is out of range; allowed: above 0 and at most 1000000 kg "
         "(the largest satellite, the ISS, is 4.2e5 kg)",
         "line 3: mass_per_area_kg_m2=0 is out of range; allowed: 0.01 to 100000 kg/m^2 "
-        "(from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2)",
+        "(ten times beyond a solar sail's 0.1 kg/m^2 and a solid metal body's 1e4 kg/m^2, metres across)",
         "line 4: inclination_deg=200 is out of range; allowed: 0 to 180 deg",
         "line 5: apogee_km=nan is not a finite number; allowed: a finite number",
         "line 6: perigee_km=90 is out of range; allowed: 100 to 50000 km (the decay ends at the re-entry height)",

@@ -170,7 +170,7 @@ _LAW = ["--rho0", "1.3", "--h0-km", "0"]
         (
             [*_ORBIT, "--mass-per-area", "0"],
             "--mass-per-area 0 is out of range; allowed: 0.01 to 100000 kg/m^2 "
-            "(from a solar sail, 0.1 kg/m^2, to a solid metal body metres across, 1e4 kg/m^2)",
+            "(ten times beyond a solar sail's 0.1 kg/m^2 and a solid metal body's 1e4 kg/m^2, metres across)",
         ),
         (
             [*_ORBIT, "--cx", "-1"],

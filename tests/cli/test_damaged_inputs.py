@@ -137,3 +137,103 @@ def test_a_solar_table_that_ends_before_the_decay_starts_is_refused(tmp_path, ca
     status, out, err = run(capsys, *argv, "--epoch", "2020-01-01")
     assert status == 2 and out == ""
     assert "ends on 2013-10-02, before the decay starts on 2020-01-01" in err
+
+
+ORBIT = ["lifetime", "--perigee", "300", "--apogee", "400"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "start"),
+    [
+        # An OverflowError traceback, and 1e150 blamed on "--area 7.85e+299".
+        (["--shape", "sphere", "--mass", "10", "--diameter-m", "1e160"], "--diameter-m 1e160 is out of range"),
+        (["--shape", "sphere", "--mass", "10", "--diameter-m", "1e150"], "--diameter-m 1e150 is out of range"),
+        # Read as the year 20200101 ("out of range"); a bad month echoed as '2020-13-15'.
+        (["--epoch", "20200101"], "cannot read the date '20200101'"),
+        (["--epoch", "2020-13"], "cannot read the date '2020-13';"),
+        # "mass_kg / area_m2=1e-300", a parameter's name on the command line.
+        (["--mass", "1e-300", "--area", "1"], "--mass / --area 1e-300 is out of range; allowed: 0.01 to 100000"),
+        # "must be a positive integer" for 0, "an integer 10 to 1000000" for 1.
+        (["--uncertainty", "--samples", "0"], "--samples 0 is out of range; allowed: an integer 10 to 1000000"),
+        (["--inclination", "98"], "--inclination changes nothing under --atmosphere paper"),
+        (["--atmosphere", "msis", "--daily-ap"], "--daily-ap chooses a dated decay's Ap: it goes with --epoch"),
+    ],
+)
+def test_a_value_is_refused_in_the_command_lines_words(capsys, argv, start):
+    status, out, err = run(capsys, *ORBIT, *argv)
+    assert status == 2 and out == ""
+    assert err.startswith(f"orbit-env: error: {start}") and err.count("\n") == 1, err
+
+
+def test_a_number_beyond_any_orbit_is_printed_in_four_digits(capsys):
+    status, _, err = run(capsys, "lifetime", "--semi-major-axis-km", "1e300", "--eccentricity", "0")
+    assert status == 2 and "(a = 1e+300 km, e = 0.0000000) is flown at 1e+300 x 1e+300 km" in err
+    assert len(err) < 300  # it had printed 301 digits three times
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        ([*ORBIT, "--trajectory", ""], "--trajectory"),
+        ([*ORBIT, "--plot", ""], "--plot"),
+        (["fig2", "--out", ""], "--out"),
+    ],
+)
+def test_an_empty_output_name_is_refused(capsys, tmp_path, monkeypatch, argv, flag):
+    # --trajectory "" and --plot "" had written nothing and exited 0; fig2 --out "" said "--out  is a directory".
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    assert f"argument {flag}: an empty file name" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_standard_output_is_no_output_file(capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # --trajectory - had written a file named "-"
+    with pytest.raises(SystemExit):
+        main([*ORBIT, "--trajectory", "-"])
+    assert "'-' (standard output) is not written to" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_figure_format_that_needs_latex_is_offered_only_with_latex(capsys, tmp_path):
+    import shutil
+
+    pytest.importorskip("matplotlib")
+    from matplotlib import rcParams
+
+    if shutil.which(rcParams["pgf.texsystem"]) is not None:
+        pytest.skip("this machine has LaTeX: PGF is written")
+    # The figure had been refused only after the computing: "RuntimeError: 'xelatex' not found".
+    status, out, err = run(capsys, *ORBIT, "--plot", tmp_path / "decay.pgf")
+    assert status == 2 and out == "" and "the file name's extension gives the figure's format" in err
+    assert ".pgf" not in err.split("allowed:")[1]
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--reentry-sigma-days", "2"], "--reentry-sigma-days is an uncertainty of a fit to a re-entry"),
+        (["--height-sigma-km", "2"], "--height-sigma-km is an uncertainty of a fit to a re-entry"),
+    ],
+)
+def test_fit_density_refuses_a_re_entrys_uncertainty_without_the_re_entry(capsys, tmp_path, argv, message):
+    path = tmp_path / "obs.csv"
+    path.write_text(OBSERVATIONS)
+    status, _, err = run(capsys, "fit-density", path, *argv)
+    assert status == 2 and message in err
+    assert run(capsys, "fit-density", path, "--reentry", "200", *argv)[0] == 0
+
+
+def test_options_that_change_nothing_with_element_sets_are_refused(capsys, tmp_path):
+    path = tmp_path / "set.tle"
+    path.write_text(f"{LINE1}\n{LINE2}\n")
+    status, _, err = run(capsys, "lifetime", "--tle", path, "--drag-from", "ndot", "--mass", "10", "--area", "1")
+    assert status == 2 and "--drag-from chooses what an element set's drag is read from" in err
+    batch = tmp_path / "batch.csv"
+    batch.write_text("perigee_km,apogee_km\n300,400\n")
+    argv = ["lifetime", "--batch", batch, "--out", tmp_path / "o.csv", "--semi-major-axis-km", "6800"]
+    status, _, err = run(capsys, *argv, "--eccentricity", "0")
+    assert status == 2 and "do not give --semi-major-axis-km/--eccentricity" in err
+    assert not (tmp_path / "o.csv").exists()
