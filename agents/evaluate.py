@@ -546,6 +546,8 @@ def all_policies(
     algorithm (``ppo``, ``a2c``, ...), or ``learned_name`` (listed last; not a
     baseline's or the DP's name). ``dp_lookahead``, ``dp_rollout``: the DP policy's (`dp_policy`).
     """
+    if learned_name is not None and not learned_name.strip():
+        raise ValueError(f"learned_name={learned_name!r} is blank; allowed: a row's name, or None (the algorithm's)")
     if learned_name is not None and learned_name in (*HAND_CODED, "dp"):
         raise ValueError(f"the learned agent's row may not be named {learned_name!r}: a baseline's or the DP's row")
     learned = load_model(env_id, model_path, warn)

@@ -72,22 +72,21 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     from orbit_env.envs import SOLAR_ENV_IDS
 
     check_int(args.seed, "seed", low=0)  # before the model's load and the DP's solve
+    if args.no_dp and not args.certify:  # (--certify names --no-dp itself)
+        dp_flags = [_flag(name) for name in ("dp_lookahead", "dp_rollout") if _given(args, name)]
+        if dp_flags:
+            raise ValueError(f"--no-dp leaves the DP policy out: it takes no {' or '.join(dp_flags)}")
     _solar_options(args, args.env in SOLAR_ENV_IDS)
-    if args.plot and not args.certify:
+    # An empty file name is a name given (check_output refuses it), not a flag left out.
+    if args.plot is not None and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
-    if args.returns and not args.certify:
+    if args.returns is not None and not args.certify:
         check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
-        flags = {
-            "--model": args.model,
-            "--plot": args.plot,
-            "--no-dp": args.no_dp,
-            "--returns": args.returns,
-            "--name": args.name,
-        }
-        given = [flag for flag, value in flags.items() if value]
-        if given:  # the certificate searches plans against the DP: no learned row, no returns to draw
-            raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(given)}")
+        names = ("model", "plot", "no_dp", "returns", "name")
+        refused = [_flag(name) for name in names if _given(args, name)]
+        if refused:  # the certificate searches plans against the DP: no learned row, no returns to draw
+            raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(refused)}")
         return _certify(args, say)
     if args.env in SOLAR_ENV_IDS:
         return _evaluate_solar(args, say)
@@ -103,9 +102,9 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         learned_name=args.name,
     )
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
-    if args.plot:
+    if args.plot is not None:
         plot_returns(results, args.env, args.plot)
-    if args.returns:
+    if args.returns is not None:
         write_returns(results, args.returns)
     # The learned agent against the best hand-coded policy, then against the optimum.
     learned = args.name or next((name for name in results if name in ALGORITHMS), "ppo")
@@ -123,10 +122,19 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _given(args: argparse.Namespace, name: str) -> bool:
+    """Whether the option ``name`` was given: a value (an empty one too) or a switch on."""
+    return getattr(args, name) not in (None, False)
+
+
+def _flag(name: str) -> str:
+    return f"--{name.replace('_', '-')}"
+
+
 def _solar_options(args: argparse.Namespace, solar: bool) -> None:
     """Refuse the options of one kind of env given for the other (they would do nothing); fill in the defaults."""
     only_solar = ("solar_split", "disposal_years", "workers")
-    given = [f"--{name.replace('_', '-')}" for name in only_solar if getattr(args, name) is not None]
+    given = [_flag(name) for name in only_solar if getattr(args, name) is not None]
     if not solar and given:
         verb = "applies" if len(given) == 1 else "apply"
         raise ValueError(
@@ -176,9 +184,9 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
         continuous=args.env == SOLAR_CONTINUOUS_ENV_ID,
     )
     results = {name: flown.episodes() for name, flown in evaluation.flown.items()}
-    if args.plot:
+    if args.plot is not None:
         plot_returns(results, f"{args.env} ({args.solar_split} split)", args.plot)
-    if args.returns:
+    if args.returns is not None:
         write_returns(results, args.returns)
     table = summarize(results)
     report = solar_report(evaluation)
@@ -279,7 +287,7 @@ def _cmd_curves(args: argparse.Namespace) -> int:
     from orbit_env.agents.curves import curves, format_curves, plot_curves
 
     algos = [a.strip() for a in args.algos.split(",") if a.strip()]
-    if args.plot:
+    if args.plot is not None:
         check_figure(args.plot, "--plot")
     result = curves(
         args.env,
@@ -292,17 +300,33 @@ def _cmd_curves(args: argparse.Namespace) -> int:
         workers=args.workers,
         progress=lambda text: print(f"  {text} ...", file=sys.stderr),
     )
-    if args.plot:
+    if args.plot is not None:
         plot_curves(result, args.plot)
     print(json.dumps(result) if args.json else format_curves(result))
     return 0
+
+
+def _folder(text: str) -> str:
+    """The argparse type of an output folder: not empty (an empty path is the current folder, never meant)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder")
+    return text
+
+
+def _row_name(text: str) -> str:
+    """The argparse type of a table row's name: not blank (the row would have no name to read)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"a blank name ({text!r}); give the row a name")
+    return text
 
 
 def add_parsers(sub: Any) -> None:
     """The ``train``, ``evaluate``, ``sweep`` and ``curves`` commands."""
     tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
     tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
-    tr.add_argument("--out", default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)")
+    tr.add_argument(
+        "--out", type=_folder, default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)"
+    )
     tr.add_argument(
         "--timesteps", type=positive_int, metavar="N", help="override total_timesteps (rounded up to whole rollouts)"
     )
@@ -339,6 +363,7 @@ def add_parsers(sub: Any) -> None:
     )
     ev.add_argument(
         "--name",
+        type=_row_name,
         metavar="ROW",
         help="the learned agent's row (default: its algorithm, ppo, a2c, ...): two models of one algorithm "
         "side by side, each run under its own name",
@@ -395,7 +420,9 @@ def add_parsers(sub: Any) -> None:
     sw.add_argument("--algos", default="ppo,a2c", metavar="A,B", help="ppo, a2c, dqn, sac, td3, ppo_recipe")
     sw.add_argument("--seeds", type=positive_int, default=5, metavar="N", help="seeds 0..N-1 (default 5)")
     sw.add_argument("--timesteps", type=positive_int, default=100_000, metavar="T", help="per trial")
-    sw.add_argument("--out", required=True, metavar="DIR", help="results.json, the models, Ray's state (resumable)")
+    sw.add_argument(
+        "--out", type=_folder, required=True, metavar="DIR", help="results.json, the models, Ray's state (resumable)"
+    )
     sw.add_argument("--address", metavar="RAY_ADDRESS", help="a Ray cluster (default: a local Ray)")
     sw.add_argument(
         "--episodes",
@@ -434,7 +461,9 @@ def add_parsers(sub: Any) -> None:
         help=f"evaluation episodes, seed {EVAL_SEED} (default {EVAL_EPISODES})",
     )
     cu.add_argument("--workers", type=positive_int, default=1, metavar="N", help="runs at once (default 1)")
-    cu.add_argument("--out", required=True, metavar="DIR", help="the runs' curves and results.json (resumable)")
+    cu.add_argument(
+        "--out", type=_folder, required=True, metavar="DIR", help="the runs' curves and results.json (resumable)"
+    )
     cu.add_argument("--plot", metavar="PNG", help="draw the curves")
     cu.add_argument("--json", action="store_true", help="print results.json's content")
     cu.set_defaults(func=_cmd_curves)

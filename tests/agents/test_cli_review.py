@@ -18,6 +18,14 @@ from orbit_env.agents.train import TrainingInterrupted, newest_checkpoint, train
 from orbit_env.cli import main
 
 
+def status(args) -> int:
+    """The command's exit status, also where argparse exits (a flag's value refused by its type)."""
+    try:
+        return main(args)
+    except SystemExit as exit:
+        return exit.code
+
+
 def one_line_error(capsys) -> str:
     """The error a command printed: one line on stderr, no traceback."""
     err = capsys.readouterr().err
@@ -233,3 +241,54 @@ def test_validation_scores_the_policy_updated_on_the_steps_it_is_labelled_with(t
     assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128]
     final, best = policy_of(out / "model.zip"), policy_of(out / "best_model.zip")  # the one score's model
     assert all(torch.equal(final[key], best[key]) for key in final)
+
+
+# --------------------------------------------------------------------------------------
+# No flag silently ignored: refused in one line
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        # they set the DP policy that --no-dp leaves out
+        (["evaluate", "--no-dp", "--dp-lookahead", "2"], "--no-dp leaves the DP policy out: it takes no --dp-lookah"),
+        (["evaluate", "--no-dp", "--dp-rollout"], "--no-dp leaves the DP policy out: it takes no --dp-rollout"),
+        (["evaluate", "--env", "OrbitRaisingSolar-v0", "--no-dp", "--dp-rollout"], "it takes no --dp-rollout"),
+        # a row without a name (the algorithm's had been used)
+        (["evaluate", "--no-dp", "--name", ""], "argument --name: a blank name (''); give the row a name"),
+        (["evaluate", "--no-dp", "--name", " "], "argument --name: a blank name (' ')"),
+        # the current folder, never meant
+        (["train", "--out", ""], "argument --out: an empty path; give a folder"),
+        (["curves", "--out", ""], "argument --out: an empty path; give a folder"),
+        (["sweep", "--out", ""], "argument --out: an empty path; give a folder"),
+        # an empty file name reaches the output's check (it had been taken for no flag)
+        (["evaluate", "--no-dp", "--returns", ""], "--returns "),
+        (["evaluate", "--no-dp", "--plot", ""], "--plot "),
+        (["curves", "--out", "curves", "--plot", ""], "--plot "),
+        (["evaluate", "--certify", "--plot", ""], "--certify searches plans against the DP policy: it takes no --plot"),
+    ],
+)
+def test_a_flag_that_would_do_nothing_is_refused(tmp_path, monkeypatch, capsys, args, message):
+    from orbit_env.agents import curves as curves_module
+    from orbit_env.agents import sweep as sweep_module
+    from orbit_env.agents import train as train_module
+
+    def ran(*args, **kwargs):
+        raise AssertionError("the command ran")  # (a refused command returns before; this one would train)
+
+    for module, name in ((train_module, "train"), (curves_module, "curves"), (sweep_module, "sweep")):
+        monkeypatch.setattr(module, name, ran)
+    monkeypatch.chdir(tmp_path)
+    if args[0] == "evaluate":
+        args = [*args, "--episodes", "2"]  # quick, if it ran
+    assert status(args) == 2
+    assert message in one_line_error(capsys)
+    assert not list(tmp_path.iterdir())  # nothing written in the current folder
+
+
+def test_the_api_refuses_a_blank_row_name():
+    from orbit_env.agents.evaluate import all_policies
+
+    with pytest.raises(ValueError, match=r"^learned_name='' is blank"):
+        all_policies("OrbitRaising-v0", include_dp=False, learned_name="")
