@@ -16,10 +16,17 @@ generations (``<kind>-<hash>`` at the folder's top, of this package's kinds) not
 `FLAT_KEPT_S`. Nothing else in the folder is touched: a generation is deleted only if it holds
 the marker this module writes; what cannot be deleted stays (`prune`).
 
-Writes are atomic: a table is written to a temporary file in the same folder and
-renamed over its name, so processes that race build the same table twice at most
+Writes are atomic: a table is written to a temporary file in the same folder, flushed to
+the disk, and renamed over its name, so processes that race build the same table twice at most
 and never read a half-written one. A cache that cannot be read or written (a
 read-only home, a full disk) is passed over: the table is built in memory.
+
+Reads are checked: a ``.npz`` by the CRC-32 of each array that the zip format keeps; a mapped folder
+by its ``check.json``, each file's size and the CRC-32 of `CHECK_SLICES` slices of `CHECK_BYTES`
+spread over it (a file read whole would cost milliseconds of the few pages a lookup maps). A table
+that does not match (zeroed by a power cut, overwritten) is built again and rewritten, never used:
+its lookups had given lifetimes of 0 days with no word. A change between two checked slices
+escapes the mapped folder's check.
 
 Control:
 
@@ -34,6 +41,7 @@ import contextlib
 import dataclasses
 import functools
 import hashlib
+import json
 import math
 import os
 import re
@@ -41,6 +49,7 @@ import shutil
 import tempfile
 import time
 import zipfile
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -256,8 +265,11 @@ def load(kind: str, description: str | None, *, mapped: bool = False) -> dict[st
     try:
         if mapped:
             folder = path.with_suffix("")
+            files = sorted(folder.glob("*.npy"))
+            if not files or _checks(files) != json.loads((folder / CHECK_FILE).read_text()):
+                return None  # damaged, or written before the check: built again
             # Read-only views of the mapped files, without memmap's slower methods (take).
-            return {f.stem: np.load(f, mmap_mode="r").view(np.ndarray) for f in folder.glob("*.npy")} or None
+            return {f.stem: np.load(f, mmap_mode="r").view(np.ndarray) for f in files}
         if not path.is_file():
             return None
         with np.load(path, allow_pickle=False) as data:
@@ -287,12 +299,35 @@ def store(
         try:
             with os.fdopen(handle, "wb") as file:
                 (np.savez_compressed if compress else np.savez)(file, **arrays)
+                _flush(file)
             os.replace(temporary, path)
         except BaseException:
             Path(temporary).unlink(missing_ok=True)
             raise
-    except OSError:
+    except OSError as error:
+        _unwritable(path.parent, error)
+
+
+class CacheWarning(UserWarning):
+    """The disk cache cannot be written: tables are built again in every run (said once a process)."""
+
+
+_warned: set[Path] = set()
+
+
+def _unwritable(folder: Path, error: OSError) -> None:
+    """Say once a process that the cache folder cannot be written, and what that costs."""
+    if folder in _warned:
         return
+    _warned.add(folder)
+    import warnings
+
+    warnings.warn(
+        f"the disk cache {folder} cannot be written ({error.strerror or error}): its tables are built again in "
+        f"every run; {ENV_VAR}=DIR moves it",
+        CacheWarning,
+        stacklevel=3,
+    )
 
 
 def stamp(kind: str, description: str | None) -> tuple[int, int] | None:
@@ -331,17 +366,50 @@ def locked(kind: str, description: str | None) -> Iterator[None]:
         yield
 
 
+#: A mapped table's check file, and the slices of each of its files that the check reads.
+CHECK_FILE = "check.json"
+CHECK_SLICES = 32
+CHECK_BYTES = 2048
+
+
+def _checks(files: list[Path]) -> dict[str, list[int]]:
+    """Each file's size and the CRC-32 of `CHECK_SLICES` slices of `CHECK_BYTES` spread evenly over it."""
+    checks = {}
+    for path in files:
+        size = path.stat().st_size
+        crc = 0
+        with open(path, "rb") as handle:
+            for k in range(CHECK_SLICES):
+                handle.seek(k * max(size - CHECK_BYTES, 0) // (CHECK_SLICES - 1))
+                crc = zlib.crc32(handle.read(CHECK_BYTES), crc)
+        checks[path.stem] = [size, crc]
+    return checks
+
+
+def _flush(file: Any) -> None:
+    """A written file's bytes to the disk before it is renamed into place (a power cut then leaves it whole)."""
+    file.flush()
+    os.fsync(file.fileno())
+
+
 def _store_folder(folder: Path, arrays: dict[str, np.ndarray]) -> None:
     """The arrays as ``.npy`` files in ``folder``, written in a temporary folder renamed to it (atomic)."""
     temporary = Path(tempfile.mkdtemp(dir=folder.parent, prefix=folder.name, suffix=".tmp"))
     try:
         for name, array in arrays.items():
-            np.save(temporary / f"{name}.npy", array, allow_pickle=False)
+            with open(temporary / f"{name}.npy", "wb") as file:
+                np.save(file, array, allow_pickle=False)
+                _flush(file)
+        check = _checks(sorted(temporary.glob("*.npy")))
+        with open(temporary / CHECK_FILE, "w") as file:
+            json.dump(check, file)
+            _flush(file)
         if folder.exists():  # unreadable (`load` gave None): replaced (a rename onto a folder with files fails)
             shutil.rmtree(folder, ignore_errors=True)
-        os.replace(temporary, folder)
-    except OSError:  # another process wrote the folder in between: its copy stays
-        pass
+        try:
+            os.replace(temporary, folder)
+        except OSError:  # another process wrote the folder in between: its copy stays
+            pass
     finally:
         if temporary.exists():
             for file in temporary.iterdir():

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from orbit_env.analysis.catalogue_io import DRAG_SOURCE_KEY, ID_COLUMNS, LINE_KEY, format_value
 from orbit_env.analysis.disposal import check_disposal_rule
@@ -233,6 +233,11 @@ def row_start_days(orbits: Any, scenario: Scenario, own_epochs: bool) -> FloatAr
     return None if scenario.epoch_days is None else np.full(len(orbits.rows), scenario.epoch_days)
 
 
+def inclination_group(inclination_deg: ArrayLike) -> FloatArray:
+    """The inclination a row's decay is computed at: its own rounded to `INCLINATION_STEP_DEG` (its group)."""
+    return np.round(np.asarray(inclination_deg, dtype=np.float64) / INCLINATION_STEP_DEG) * INCLINATION_STEP_DEG
+
+
 def batch_lifetimes(
     rows: Sequence[dict[str, str]],
     perigee_m: FloatArray,
@@ -277,7 +282,7 @@ def batch_lifetimes(
     dv = np.full(n, np.nan)
     depends_on_inclination = scenario.depends_on_inclination
     if depends_on_inclination:
-        group_of = np.round(inclination_deg / INCLINATION_STEP_DEG) * INCLINATION_STEP_DEG
+        group_of = inclination_group(inclination_deg)
     else:
         group_of = np.zeros(n)
     groups = np.unique(group_of[ok])
@@ -331,7 +336,9 @@ def batch_lifetimes(
                 counted(1.0)
     for i in np.flatnonzero(ok & ~reentered):
         if rule_years is None:
-            status[i] = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"
+            why = f"still in orbit after {scenario.max_years:g} years (the time-stepped path stops there)"
+            line = rows[i].get(LINE_KEY)
+            status[i] = f"line {line}: {why}" if line else why
     for i in np.flatnonzero(ok & reentered & ~(days <= MAX_LIFETIME_YEARS * DAYS_PER_YEAR)):
         try:
             check_lifetime_days(float(days[i]))

@@ -202,30 +202,59 @@ def format_value(value: float) -> str:
 
 
 @contextmanager
-def atomic_text(path: str | Path) -> Iterator[TextIO]:
+def atomic_text(path: str | Path, *, replace: bool = True) -> Iterator[TextIO]:
     """A text file written whole or not at all: a temporary file beside ``path``, renamed to it once complete.
 
-    A reader never sees half a file, and a failure leaves any earlier file as it was.
+    A reader never sees half a file, and a failure leaves any earlier file as it was; an error of the
+    disk (full) names ``path``. ``replace=False``: a file that appeared at ``path`` meanwhile (another
+    command's) is kept, and this one's text is left beside it under a name the ValueError gives.
     """
     out = Path(path)
     handle = tempfile.NamedTemporaryFile(
         "w", newline="", encoding="utf-8", dir=out.parent, prefix=f".{out.name}.", suffix=".tmp", delete=False
     )
     try:
-        with handle:
-            yield handle
+        try:
+            with handle:
+                yield handle
+        except OSError as error:
+            if error.filename is None:  # a write's error (a full disk) names no file: this one's
+                raise OSError(error.errno, error.strerror, str(out)) from None
+            raise
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(handle.name, 0o666 & ~umask)  # a temporary file is private; the results are not
-        os.replace(handle.name, out)
+        if replace:
+            os.replace(handle.name, out)
+        else:
+            _place_new(Path(handle.name), out)
     except BaseException:
         Path(handle.name).unlink(missing_ok=True)
         raise
 
 
-def write_records(path: str | Path, records: list[dict[str, Any]]) -> None:
-    """Write output records as CSV with LF line endings, atomically (`atomic_text`)."""
-    with atomic_text(path) as handle:
+def _place_new(written: Path, out: Path) -> None:
+    """Rename ``written`` to ``out`` unless a file is there (a link fails on one: no check-then-write race)."""
+    try:
+        os.link(written, out)
+    except FileExistsError:
+        kept = out.with_name(f"{out.name}.{os.getpid()}.new")
+        os.replace(written, kept)
+        raise ValueError(
+            f"{out} appeared while this command ran (another command wrote it) and is kept; this command's "
+            f"results are in {kept}"
+        ) from None
+    except OSError:  # a file system without hard links: checked, then renamed
+        if out.exists():
+            raise ValueError(f"{out} appeared while this command ran (another command wrote it)") from None
+        os.replace(written, out)
+        return
+    written.unlink()
+
+
+def write_records(path: str | Path, records: list[dict[str, Any]], *, replace: bool = True) -> None:
+    """Write output records as CSV with LF line endings, atomically (`atomic_text`, and its ``replace``)."""
+    with atomic_text(path, replace=replace) as handle:
         writer = csv.DictWriter(handle, fieldnames=list(records[0]), lineterminator="\n")
         writer.writeheader()
         writer.writerows(records)

@@ -20,6 +20,7 @@ never reuses stale parts.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import json
@@ -27,12 +28,13 @@ import math
 import re
 import signal
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from orbit_env.analysis.catalogue_io import atomic_text, write_records
+from orbit_env.cache import fcntl
 from orbit_env.workers import spawned_pool
 
 if TYPE_CHECKING:
@@ -122,6 +124,51 @@ def run_in_parts(
     """
     folder = parts_folder(out)
     folder.mkdir(exist_ok=True)
+    with _owned(folder, out):
+        return _run_owned(
+            out, folder, key, n_rows, rows_per_chunk, compute, workers, address, progress, restart, report
+        )
+
+
+#: The lock file of a parts folder: held by the command computing into it.
+LOCK_NAME = ".lock"
+
+
+@contextlib.contextmanager
+def _owned(folder: Path, out: str | Path) -> Iterator[None]:
+    """Hold ``folder``'s lock while a command computes into it; another command's hold is an error.
+
+    Two commands on one results file had both computed every chunk, and the second ended in "no such file"
+    when the first had joined the parts and removed the folder. (No lock where the platform has no flock.)
+    """
+    if fcntl is None:
+        yield
+        return
+    with open(folder / LOCK_NAME, "a") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)  # released when the file is closed
+        except BlockingIOError:
+            raise ValueError(
+                f"another command is computing the parts of {out} in {folder} now; wait for it to end (or stop "
+                "it), then run this one again"
+            ) from None
+        yield
+
+
+def _run_owned(
+    out: str | Path,
+    folder: Path,
+    key: str,
+    n_rows: int,
+    rows_per_chunk: int,
+    compute: Compute,
+    workers: int,
+    address: str | None,
+    progress: bool,
+    restart: bool,
+    report: Callable[[str], None],
+) -> JoinedParts:
+    """`run_in_parts` in a parts folder this command holds."""
     bounds = [(start, min(start + rows_per_chunk, n_rows)) for start in range(0, n_rows, rows_per_chunk)]
     done, deleted = _found_parts(folder, key, len(bounds), restart)
     missing = [k for k in range(len(bounds)) if k not in done]
@@ -149,9 +196,10 @@ def run_in_parts(
                 keep(k, compute(start, stop))
         else:
             _run_pool(compute, chunks, processes, keep)
-    joined = _join(out, [_part_path(folder, key, k) for k in range(len(bounds))])
+    joined = _join(out, [_part_path(folder, key, k) for k in range(len(bounds))], replace=restart)
     for k in range(len(bounds)):
         _part_path(folder, key, k).unlink()
+    (folder / LOCK_NAME).unlink(missing_ok=True)
     folder.rmdir()
     return joined
 
@@ -278,6 +326,8 @@ def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> tuple[se
     deleted = 0
     for path in sorted(folder.iterdir()):
         match = _PART.match(path.name)
+        if path.name == LOCK_NAME:
+            continue
         if path.name.startswith(".") and path.name.endswith(".tmp"):
             path.unlink()  # a part whose write was stopped
         elif match is None:
@@ -285,8 +335,9 @@ def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> tuple[se
         elif match["fingerprint"] != key or int(match["chunk"]) >= chunks:
             if not restart:
                 raise ValueError(
-                    f"{folder} holds the parts of another run (other inputs or options); run that command again to "
-                    "finish it, or give --force to delete its parts and start this one"
+                    f"{folder} holds the parts of another run (other inputs or options, or another version of this "
+                    "package: its code is part of a run's fingerprint); run that command again to finish it, or "
+                    "give --force to delete its parts and start this one"
                 )
             path.unlink()
             deleted += 1
@@ -295,13 +346,13 @@ def _found_parts(folder: Path, key: str, chunks: int, restart: bool) -> tuple[se
     return done, deleted
 
 
-def _join(out: str | Path, parts: list[Path]) -> JoinedParts:
-    """Write the parts' rows under one header into ``out`` (atomically); count what they hold."""
+def _join(out: str | Path, parts: list[Path], *, replace: bool) -> JoinedParts:
+    """Write the parts' rows under one header into ``out`` (atomically, `atomic_text`'s ``replace``); count them."""
     rows = ok = 0
     first_status = None
     max_days = 0.0
     header = None
-    with atomic_text(out) as handle:
+    with atomic_text(out, replace=replace) as handle:
         for part in parts:
             text = part.read_text(encoding="utf-8")
             head, _, body = text.partition("\n")

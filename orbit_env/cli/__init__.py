@@ -9,11 +9,13 @@ cause ends in one line on stderr and exit status 2, in the command line's words.
 
 from __future__ import annotations
 
+import functools
 import os
 import signal
 import sys
 import threading
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from orbit_env import cache
@@ -54,6 +56,14 @@ def _in_files(error: Exception, args: object) -> str:
     return f"{where}{error.filename}: {error.strerror.lower()}"
 
 
+def _show_warning(default: Callable[..., None], message: Any, category: type[Warning], *rest: Any, **kw: Any) -> None:
+    """An unwritable cache in one line, as the command's other warnings; other warnings as Python shows them."""
+    if issubclass(category, cache.CacheWarning):
+        print(f"{PROG}: warning: {message}", file=sys.stderr)
+    else:
+        default(message, category, *rest, **kw)
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     """SIGTERM as Ctrl-C (see `main`)."""
     raise KeyboardInterrupt
@@ -83,6 +93,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     # set outside Python (which could not be put back); restored after.
     ours = threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGTERM) is not None
     before = signal.signal(signal.SIGTERM, _interrupt) if ours else None
+    shown = warnings.showwarning
+    warnings.showwarning = functools.partial(_show_warning, shown)
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
@@ -94,5 +106,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
     finally:
+        warnings.showwarning = shown
         if ours:
             signal.signal(signal.SIGTERM, before)

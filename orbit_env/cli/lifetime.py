@@ -314,8 +314,15 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
     if args.uncertainty:
         try:
             joined = uncertain_batch.run(args, orbits, air)
-        except (KeyboardInterrupt, BrokenProcessPool) as stop:
-            why = "stopped" if isinstance(stop, KeyboardInterrupt) else f"a worker process died ({stop})"
+        except (KeyboardInterrupt, BrokenProcessPool, OSError) as stop:
+            if isinstance(stop, OSError) and not parts_folder(args.out).is_dir():
+                raise  # nothing computed yet: the error alone
+            if isinstance(stop, KeyboardInterrupt):
+                why = "stopped"
+            elif isinstance(stop, BrokenProcessPool):
+                why = f"a worker process died ({stop})"
+            else:  # a full disk: the file named, and what was kept said
+                why = f"error: {stop.filename}: {(stop.strerror or '').lower()}" if stop.filename else f"error: {stop}"
             print(
                 f"{PROG}: {why}; the finished chunks are kept in {parts_folder(args.out)}: the same command "
                 "resumes from them",
@@ -336,7 +343,8 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
             progress=not args.no_progress,
             epoch_days=row_start_days(orbits, scenario, getattr(args, "rows_own_epochs", False)),
         )
-        write_records(args.out, orbit_inputs.records_in_reference(records, args.height_reference))
+        records = orbit_inputs.records_in_reference(records, args.height_reference)
+        write_records(args.out, records, replace=args.force)  # a file another command wrote meanwhile is kept
         rows, ok = summary.rows, summary.ok
         first = next((record["status"] for record in records if record["status"] != "ok"), None)
         max_days = max((float(record["days"]) for record in records if record["days"]), default=0.0)

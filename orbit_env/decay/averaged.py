@@ -74,7 +74,9 @@ class DecayModel:
         rotating_atmosphere: Let the air co-rotate with the Earth (section 5).
             Then the inclination matters: a prograde (east-going) orbit meets a
             slower wind and lives longer than a retrograde one.
-        inclination_deg: Orbit inclination, used only with a rotating atmosphere.
+        inclination_deg: Orbit inclination, used only with a rotating atmosphere; in still air it is
+            held at 0, so that the models of one profile are one model (one curve family in the
+            caches, whatever inclination a catalogue's rows give).
         quadrature_points: Anomalies in the orbit average.
     """
 
@@ -86,6 +88,8 @@ class DecayModel:
     def __post_init__(self) -> None:
         check_number(self.inclination_deg, "inclination_deg", unit="deg", low=0.0, high=180.0)
         check_int(self.quadrature_points, "quadrature_points", low=8)
+        if not self.rotating_atmosphere:
+            object.__setattr__(self, "inclination_deg", 0.0)
 
     @property
     def corotation_rad_s(self) -> float:
