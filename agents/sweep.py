@@ -269,6 +269,15 @@ def _progress_callback(tune: Any, total: int, say: Callable[[str], None]) -> Any
     return Progress()
 
 
+def starts_ray(address: str | None) -> bool:
+    """Whether ``ray.init(address)`` starts a Ray of its own, whose CPUs a sweep may set.
+
+    ``"local"`` starts a new one; None starts one unless a Ray runs already on this machine (Ray then
+    refuses the CPUs itself); any other address joins a running Ray.
+    """
+    return address in (None, "local")
+
+
 def _ray_trainable(config: dict[str, Any]) -> None:
     from ray import tune
 
@@ -293,7 +302,7 @@ def sweep(
 ) -> dict[str, Any]:
     """Run the trials on Ray Tune, write ``out_dir/results.json``, return its content (see the module).
 
-    ``cpus``: the CPUs of the local Ray (default: the cores; not with ``address``), so at most
+    ``cpus``: the CPUs of the Ray the sweep starts (`starts_ray`; default: the cores), so at most
     ``cpus / cpus_per_trial`` trials run at once. ``workers``: the solar task's processes
     solving the references' DPs (`capture_references`).
 
@@ -322,8 +331,13 @@ def sweep(
         raise ValueError(f"algorithms {', '.join(repeated)} given twice: each is one row of seeds")
     if seeds < 1 or timesteps < 1 or episodes < 1:
         raise ValueError("seeds, timesteps and episodes must be >= 1")
-    if cpus is not None and (address is not None or cpus < 1):
-        raise ValueError(f"cpus={cpus} is invalid; allowed: an integer >= 1, for a local Ray only (no address)")
+    if cpus is not None and cpus < 1:
+        raise ValueError(f"cpus={cpus} is invalid; allowed: an integer >= 1")
+    if cpus is not None and not starts_ray(address):
+        raise ValueError(
+            f"cpus={cpus} sets the CPUs of a Ray the sweep starts (address None or 'local'); address={address!r} "
+            "joins a running Ray, which has its own: leave cpus out"
+        )
     try:
         import ray
         from ray import tune

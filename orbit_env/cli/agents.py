@@ -254,8 +254,13 @@ def _certify(args: argparse.Namespace, say: Any) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from orbit_env.agents.sweep import SweepInterrupted, format_table, sweep
+    from orbit_env.agents.sweep import SweepInterrupted, format_table, starts_ray, sweep
 
+    if args.cpus is not None and not starts_ray(args.address):
+        raise ValueError(
+            f"--cpus sets the CPUs of a Ray the sweep starts (no --address, or --address local); --address "
+            f"{args.address} joins a running Ray, which has its own: leave --cpus out"
+        )
     algos = [a.strip() for a in args.algos.split(",") if a.strip()]
     try:
         result = sweep(
@@ -423,7 +428,9 @@ def add_parsers(sub: Any) -> None:
     sw.add_argument(
         "--out", type=_folder, required=True, metavar="DIR", help="results.json, the models, Ray's state (resumable)"
     )
-    sw.add_argument("--address", metavar="RAY_ADDRESS", help="a Ray cluster (default: a local Ray)")
+    sw.add_argument(
+        "--address", metavar="RAY_ADDRESS", help="a running Ray cluster (default: a local Ray; local: a new one)"
+    )
     sw.add_argument(
         "--episodes",
         type=positive_int,
@@ -433,7 +440,10 @@ def add_parsers(sub: Any) -> None:
     )
     sw.add_argument("--no-dp", action="store_true", help="no capture (skips the DP's solve)")
     sw.add_argument(
-        "--cpus", type=positive_int, metavar="N", help="CPUs of the local Ray, one a trial (default: the cores)"
+        "--cpus",
+        type=positive_int,
+        metavar="N",
+        help="CPUs of the Ray the sweep starts (no --address, or --address local), one a trial (default: the cores)",
     )
     sw.add_argument(
         "--workers",

@@ -5,6 +5,7 @@ Each test failed before its fix.
 
 import json
 import re
+import sys
 
 import pytest
 
@@ -292,3 +293,27 @@ def test_the_api_refuses_a_blank_row_name():
 
     with pytest.raises(ValueError, match=r"^learned_name='' is blank"):
         all_policies("OrbitRaising-v0", include_dp=False, learned_name="")
+
+
+# --------------------------------------------------------------------------------------
+# sweep --cpus: what is wrong with it, said so
+# --------------------------------------------------------------------------------------
+
+
+def test_sweep_takes_cpus_for_a_ray_it_starts_and_says_why_not_for_a_running_cluster(tmp_path, monkeypatch, capsys):
+    # "--cpus 1 --address local" had been refused as "cpus=1 is invalid; allowed: an integer >= 1, for a local
+    # Ray only": address "local" is Ray's word for starting a new local Ray, where num_cpus applies.
+    monkeypatch.setitem(sys.modules, "ray", None)  # Ray absent (as here): the checks come before its import
+    base = ["sweep", "--algos", "a2c", "--seeds", "1", "--timesteps", "64", "--episodes", "2", "--no-dp"]
+    assert main([*base, "--cpus", "1", "--address", "local", "--out", str(tmp_path / "local")]) == 2
+    assert "orbit-env sweep runs on Ray Tune: pip install 'orbit-env[cluster]'" in one_line_error(capsys)
+    assert main([*base, "--cpus", "1", "--address", "ray://head:10001", "--out", str(tmp_path / "cluster")]) == 2
+    err = one_line_error(capsys)
+    assert "--cpus sets the CPUs of a Ray the sweep starts" in err and "--address ray://head:10001" in err
+    assert "is invalid" not in err
+    from orbit_env.agents.sweep import sweep
+
+    with pytest.raises(ValueError, match=r"^cpus=1 sets the CPUs of a Ray the sweep starts .*address='auto'"):
+        sweep("OrbitRaising-v0", ["a2c"], 1, 64, tmp_path / "api", address="auto", cpus=1, include_dp=False)
+    with pytest.raises(ValueError, match=r"^cpus=0 is invalid; allowed: an integer >= 1$"):
+        sweep("OrbitRaising-v0", ["a2c"], 1, 64, tmp_path / "api", cpus=0, include_dp=False)
