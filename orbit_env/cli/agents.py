@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from orbit_env.checks import check_int
-from orbit_env.cli.common import PROG, check_figure, check_output, positive_int
+from orbit_env.cli.common import PROG, check_figure, check_output, output_file, positive_int
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
@@ -77,7 +77,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         if dp_flags:
             raise ValueError(f"--no-dp leaves the DP policy out: it takes no {' or '.join(dp_flags)}")
     _solar_options(args, args.env in SOLAR_ENV_IDS)
-    # An empty file name is a name given (check_output refuses it), not a flag left out.
+    # (An empty file name is refused by the flag's type, `output_file`.)
     if args.plot is not None and not args.certify:
         check_figure(args.plot, "--plot", [("the model file of --model", args.model)])
     if args.returns is not None and not args.certify:
@@ -412,9 +412,10 @@ def add_parsers(sub: Any) -> None:
         help="the solar task: processes solving the DPs, also with --certify (default: cores)",
     )
     ev.add_argument("--json", action="store_true", help="print one JSON object")
-    ev.add_argument("--plot", metavar="PNG", help="box plot of the returns")
+    ev.add_argument("--plot", type=output_file, metavar="PNG", help="box plot of the returns")
     ev.add_argument(
         "--returns",
+        type=output_file,
         metavar="CSV",
         help="every episode's return, a column per policy (the paired differences from them, episode by episode)",
     )
@@ -474,6 +475,6 @@ def add_parsers(sub: Any) -> None:
     cu.add_argument(
         "--out", type=_folder, required=True, metavar="DIR", help="the runs' curves and results.json (resumable)"
     )
-    cu.add_argument("--plot", metavar="PNG", help="draw the curves")
+    cu.add_argument("--plot", type=output_file, metavar="PNG", help="draw the curves")
     cu.add_argument("--json", action="store_true", help="print results.json's content")
     cu.set_defaults(func=_cmd_curves)

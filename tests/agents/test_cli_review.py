@@ -263,11 +263,12 @@ def test_validation_scores_the_policy_updated_on_the_steps_it_is_labelled_with(t
         (["train", "--out", ""], "argument --out: an empty path; give a folder"),
         (["curves", "--out", ""], "argument --out: an empty path; give a folder"),
         (["sweep", "--out", ""], "argument --out: an empty path; give a folder"),
-        # an empty file name reaches the output's check (it had been taken for no flag)
-        (["evaluate", "--no-dp", "--returns", ""], "--returns "),
-        (["evaluate", "--no-dp", "--plot", ""], "--plot "),
-        (["curves", "--out", "curves", "--plot", ""], "--plot "),
-        (["evaluate", "--certify", "--plot", ""], "--certify searches plans against the DP policy: it takes no --plot"),
+        # an empty file name (it had been taken for no flag)
+        (["evaluate", "--no-dp", "--returns", ""], "argument --returns: an empty file name"),
+        (["evaluate", "--no-dp", "--plot", ""], "argument --plot: an empty file name"),
+        (["curves", "--out", "curves", "--plot", ""], "argument --plot: an empty file name"),
+        (["evaluate", "--certify", "--plot", ""], "argument --plot: an empty file name"),
+        (["evaluate", "--certify", "--plot", "box.png"], "--certify searches plans against the DP policy: it takes no"),
     ],
 )
 def test_a_flag_that_would_do_nothing_is_refused(tmp_path, monkeypatch, capsys, args, message):
