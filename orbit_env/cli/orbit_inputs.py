@@ -358,6 +358,7 @@ def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -
         offset_m=offset_m,
         drag_from=getattr(args, "drag_from", None),
         bad_sets=args.batch_bad_sets,
+        progress=not getattr(args, "no_progress", False),
     )
 
 

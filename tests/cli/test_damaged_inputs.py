@@ -237,3 +237,13 @@ def test_options_that_change_nothing_with_element_sets_are_refused(capsys, tmp_p
     status, _, err = run(capsys, *argv, "--eccentricity", "0")
     assert status == 2 and "do not give --semi-major-axis-km/--eccentricity" in err
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_batch_of_histories_shows_its_drag_fits_progress(tmp_path, capsys):
+    # The fits (NRLMSIS over each day of a history's span, cold) had run with nothing shown: 13 s for 34 objects.
+    path = tmp_path / "sets.tle"
+    path.write_text("\n".join(NSIGHT[:4]) + "\n")  # two sets of one object: a history
+    status, _, err = run(capsys, "lifetime", "--batch", path, "--out", tmp_path / "o.csv")
+    assert status == 0 and "drag: 100%" in err and "1/1" in err
+    status, _, err = run(capsys, "lifetime", "--batch", path, "--out", tmp_path / "p.csv", "--no-progress")
+    assert status == 0 and err == ""
