@@ -137,5 +137,5 @@ def test_config_rejects_an_unknown_shaping(tmp_path):
     (tmp_path / "good.toml").write_text("\n".join(lines).replace("curiosity", "never_burn_value"))
     assert load_config(tmp_path / "good.toml")["shaping"] == "never_burn_value"
     (tmp_path / "bad.toml").write_text("\n".join(lines))
-    with pytest.raises(ValueError, match="shaping='curiosity' is invalid"):
+    with pytest.raises(ValueError, match="shaping = 'curiosity' is invalid"):
         load_config(tmp_path / "bad.toml")
