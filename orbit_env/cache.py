@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import errno
 import functools
 import hashlib
 import json
@@ -387,9 +388,16 @@ def _checks(files: list[Path]) -> dict[str, list[int]]:
 
 
 def _flush(file: Any) -> None:
-    """A written file's bytes to the disk before it is renamed into place (a power cut then leaves it whole)."""
+    """A written file's bytes to the disk before it is renamed into place (a power cut then leaves it whole).
+
+    A file system that cannot sync (EINVAL, ENOTSUP: some network and FUSE mounts) is written as before.
+    """
     file.flush()
-    os.fsync(file.fileno())
+    try:
+        os.fsync(file.fileno())
+    except OSError as error:
+        if error.errno not in (errno.EINVAL, errno.ENOTSUP, errno.EOPNOTSUPP):
+            raise
 
 
 def _store_folder(folder: Path, arrays: dict[str, np.ndarray]) -> None:

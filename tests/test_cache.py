@@ -267,3 +267,43 @@ def test_a_cache_that_cannot_be_written_is_said_once(tmp_path, monkeypatch, caps
     err = capsys.readouterr().err
     assert err.count("orbit-env: warning: the disk cache") == 1 and "cannot be written" in err
     assert "ORBIT_ENV_CACHE_DIR=DIR moves it" in err and "Traceback" not in err
+
+
+def test_a_results_file_is_kept_on_a_file_system_without_links_and_a_dangling_link_is_replaced(tmp_path, monkeypatch):
+    import errno
+
+    from orbit_env.analysis.catalogue_io import write_records
+
+    out = tmp_path / "out.csv"
+    out.write_text("theirs\n")
+
+    def no_links(*args):
+        raise OSError(errno.EPERM, "Operation not permitted")
+
+    monkeypatch.setattr(os, "link", no_links)
+    with pytest.raises(ValueError, match="appeared while this command ran"):
+        write_records(out, [{"a": 1}], replace=False)
+    (kept,) = tmp_path.glob("out.csv.*.new")  # the results had been deleted on this path
+    assert out.read_text() == "theirs\n" and kept.read_text() == "a\n1\n"
+    fresh = tmp_path / "fresh.csv"
+    write_records(fresh, [{"a": 2}], replace=False)  # no file there: renamed
+    assert fresh.read_text() == "a\n2\n"
+    monkeypatch.undo()
+    dangling = tmp_path / "link.csv"
+    dangling.symlink_to(tmp_path / "nowhere" / "x.csv")
+    write_records(dangling, [{"a": 3}], replace=False)  # it had been called "another command's file"
+    assert dangling.read_text() == "a\n3\n" and not dangling.is_symlink()
+
+
+def test_a_file_system_that_cannot_sync_still_caches(folder, monkeypatch):
+    import errno
+
+    def cannot(descriptor):
+        raise OSError(errno.EINVAL, "Invalid argument")
+
+    monkeypatch.setattr(os, "fsync", cannot)
+    cache.store("dp", "a test table", {"values": np.arange(3.0)})
+    np.testing.assert_array_equal(cache.load("dp", "a test table")["values"], np.arange(3.0))
+    model = DecayModel(ExponentialAtmosphere(1e-11, 400e3, 55e3))
+    UniversalCurves(model)
+    assert cache.load("curves", cache.describe(model), mapped=True) is not None

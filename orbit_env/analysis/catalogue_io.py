@@ -234,22 +234,33 @@ def atomic_text(path: str | Path, *, replace: bool = True) -> Iterator[TextIO]:
 
 
 def _place_new(written: Path, out: Path) -> None:
-    """Rename ``written`` to ``out`` unless a file is there (a link fails on one: no check-then-write race)."""
+    """Rename ``written`` to ``out`` unless a file is there (a link fails on one: no check-then-write race).
+
+    A link at ``out`` to nothing (which the command's checks let through) is replaced, as a rename replaces it.
+    """
+    if out.is_symlink() and not out.exists():
+        os.replace(written, out)
+        return
     try:
         os.link(written, out)
     except FileExistsError:
-        kept = out.with_name(f"{out.name}.{os.getpid()}.new")
-        os.replace(written, kept)
-        raise ValueError(
-            f"{out} appeared while this command ran (another command wrote it) and is kept; this command's "
-            f"results are in {kept}"
-        ) from None
+        _keep_beside(written, out)
     except OSError:  # a file system without hard links: checked, then renamed
         if out.exists():
-            raise ValueError(f"{out} appeared while this command ran (another command wrote it)") from None
+            _keep_beside(written, out)
         os.replace(written, out)
         return
     written.unlink()
+
+
+def _keep_beside(written: Path, out: Path) -> None:
+    """Keep ``written`` under a name beside ``out`` (which another command wrote) and say so."""
+    kept = out.with_name(f"{out.name}.{os.getpid()}.new")
+    os.replace(written, kept)
+    raise ValueError(
+        f"{out} appeared while this command ran (another command wrote it) and is kept; this command's "
+        f"results are in {kept}"
+    )
 
 
 def write_records(path: str | Path, records: list[dict[str, Any]], *, replace: bool = True) -> None:

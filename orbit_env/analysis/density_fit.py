@@ -279,14 +279,16 @@ def fit_density_scale(
         raise ValueError(f"{observations.where(row)}: {error.message(show_index=False)}") from None
     if reentry is not None:
         dt_days = reentry_days(reentry, observations) - float(observations.days[0])
+        # A date without a time is a day: the re-entry may fall anywhere in it (after a tracking that morning).
+        day = isinstance(reentry, str) and observations.axis == "date" and "T" not in reentry.strip()
         if not isinstance(reentry, str):  # as the observations give times: a date or a number of days
             reentry = iso_date(float(reentry)) if observations.axis == "date" else f"{float(reentry):g}"
         if not dt_days > 0:
             raise ValueError(f"the re-entry ({reentry}) must come after the first observation")
         last = float(observations.days[-1] - observations.days[0])
-        if not dt_days > last:
+        if not dt_days + (1.0 if day else 0.0) > last:
             raise ValueError(
-                f"the re-entry ({reentry}) comes {last - dt_days:.4g} days before the last observation "
+                f"the re-entry ({reentry}) is not after the last observation "
                 f"({observations.where(observations.days.size - 1)}): an orbit cannot be observed after it re-entered"
             )
         check_number(reentry_sigma_days, "reentry_sigma_days", unit="days", low=0.0)

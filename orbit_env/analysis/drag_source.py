@@ -132,9 +132,12 @@ def drag_source(
     if inputs.shape is None and inputs.diameter_m is not None:
         raise ValueError("--diameter-m goes with --shape sphere")
     if inputs.given and inputs.drag_from is not None:
+        flags = {"--mass": inputs.mass_kg, "--area": inputs.area_m2, "--mass-per-area": inputs.mass_per_area_kg_m2}
+        flags.update({"--cx": inputs.drag_coefficient, "--shape": inputs.shape})
+        named = ", ".join(name for name, value in flags.items() if value is not None)
         raise ValueError(
-            "--drag-from chooses what an element set's drag is read from; the satellite given (--mass, --area, "
-            "--shape) flies its own drag instead: drop one of them"
+            f"--drag-from chooses what an element set's drag is read from; the satellite given ({named}) flies "
+            "its own drag instead: drop one of them"
         )
     cx = PAPER_DRAG_COEFFICIENT if inputs.drag_coefficient is None else inputs.drag_coefficient
     if inputs.shape is not None:

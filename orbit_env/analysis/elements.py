@@ -22,6 +22,7 @@ in which case no drag parameter follows from it (give the satellite instead).
 
 from __future__ import annotations
 
+import calendar
 import math
 import re
 import sys
@@ -189,6 +190,9 @@ def _check_fields(line1: str, line2: str, where1: str, where2: str) -> None:
     for line_number, first, last, field, pattern, lowest, highest in _FIELDS:
         line, where = (line1, where1) if line_number == 1 else (line2, where2)
         text = line[first - 1 : last]
+        if field == "epoch day of the year" and line1[18:20].isdigit():  # 365 days in a common year
+            year = int(line1[18:20]) + (1900 if int(line1[18:20]) >= 57 else 2000)
+            highest = 366.99999999 if calendar.isleap(year) else 365.99999999
         if not pattern.match(text):
             raise ValueError(f"{where}, columns {first}-{last}: the {field} reads {text!r}, not a number of its form")
         if (math.isfinite(lowest) or math.isfinite(highest)) and not lowest <= float(text) <= highest:
@@ -326,9 +330,14 @@ def read_tle(path: str | Path, bad: list[BadSet] | None = None) -> list[ElementS
     """
     if str(path) == "-":
         data = sys.stdin.buffer.read() if hasattr(sys.stdin, "buffer") else sys.stdin.read().encode()
-        return parse_tle_text(_text(data).splitlines(), "<stdin>", bad)
+        return parse_tle_text(_lines(_text(data)), "<stdin>", bad)
     with open(path, "rb") as handle:
-        return parse_tle_text(_text(handle.read()).splitlines(), str(path), bad)
+        return parse_tle_text(_lines(_text(handle.read())), str(path), bad)
+
+
+def _lines(text: str) -> list[str]:
+    """A file's lines, ended by LF, CRLF or CR only (`str.splitlines` also ends one at U+0085, a Latin-1 byte)."""
+    return text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
 
 
 def _text(data: bytes) -> str:

@@ -71,11 +71,6 @@ def _scenario(args: argparse.Namespace) -> Scenario:
     scenario = Scenario(air, args.density_scale, rotating, chunk_days)
     if args.chunk_days is not None and scenario.epoch_days is None:
         raise ValueError("--chunk-days is the time step of a dated decay: it goes with --epoch (or an element set's)")
-    if getattr(args, "inclination_typed", False) and not scenario.depends_on_inclination:
-        raise ValueError(
-            f"--inclination changes nothing under --atmosphere {args.atmosphere} (still air, the same at every "
-            "latitude); it goes with --atmosphere msis or --rotating-atmosphere"
-        )
     if getattr(args, "daily_ap", False) and scenario.epoch_days is None:
         raise ValueError("--daily-ap chooses a dated decay's Ap: it goes with --epoch (or an element set's)")
     table, epoch = scenario.activity, scenario.epoch_days
@@ -179,7 +174,6 @@ def _input_files(args: argparse.Namespace) -> list[tuple[str, str | None]]:
 
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
-    args.inclination_typed = args.inclination is not None
     _check_inclination(args)
     if args.trajectory and not args.batch:
         check_output(args.trajectory, "--trajectory", _input_files(args))
@@ -371,7 +365,6 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
     from orbit_env.analysis.density_fit import fit_density_scale, read_observations, reentry_days
 
     args.inclination_defaulted = args.inclination is None
-    args.inclination_typed = args.inclination is not None
     _check_inclination(args)
     if args.inclination is None:
         args.inclination = 0.0
@@ -401,7 +394,7 @@ def _cmd_fit_density(args: argparse.Namespace) -> int:
         satellite=satellite,
         scenario=scenario,
         inclination_deg=args.inclination,
-        reentry=reentry,
+        reentry=args.reentry,  # as typed: a date without a time is a day
         reentry_sigma_days=REENTRY_SIGMA_DAYS if args.reentry_sigma_days is None else args.reentry_sigma_days,
         height_sigma_km=HEIGHT_SIGMA_KM if args.height_sigma_km is None else args.height_sigma_km,
     )

@@ -242,6 +242,11 @@ def test_validation_scores_the_policy_updated_on_the_steps_it_is_labelled_with(t
     assert [e["timesteps"] for e in json.loads((out / "evaluations.json").read_text())] == [128]
     final, best = policy_of(out / "model.zip"), policy_of(out / "best_model.zip")  # the one score's model
     assert all(torch.equal(final[key], best[key]) for key in final)
+    # Two rollouts: the score at 128 is taken at the second rollout's start (after the first update), the
+    # score at 256 at the end.
+    again = tmp_path / "again"
+    train(config, again, total_timesteps=256, progress=False)
+    assert [e["timesteps"] for e in json.loads((again / "evaluations.json").read_text())] == [128, 256]
 
 
 # --------------------------------------------------------------------------------------

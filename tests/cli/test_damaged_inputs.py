@@ -7,6 +7,7 @@ that folder's README), damaged column by column with the checksum made right aga
 field under test is wrong.
 """
 
+import json
 from pathlib import Path
 
 import pytest
@@ -35,6 +36,8 @@ def damaged(line: str, column: int, text: str) -> str:
     [
         (1, 21, "400.00000000", "line 1, columns 21-32: the epoch day of the year is 400.00000000; allowed: 1 to"),
         (1, 21, "000.00000000", "line 1, columns 21-32: the epoch day of the year is 000.00000000; allowed: 1 to"),
+        # 2017 is a common year: day 366 had been read as 2018-01-01
+        (1, 21, "366.50000000", "line 1, columns 21-32: the epoch day of the year is 366.50000000; allowed: 1 to 365"),
         (1, 19, "  ", "line 1, columns 19-20: the epoch year reads '  ', not a number of its form"),
         (1, 19, "57", "line 1, columns 19-32: the epoch is 1957-09-28T09:17:16Z"),
         (1, 54, " ABCDE-3", "line 1, columns 54-61: the B* reads ' ABCDE-3'"),
@@ -72,6 +75,9 @@ def test_a_name_line_in_latin_1_is_read_and_bytes_that_are_no_text_name_a_line(t
     named.write_bytes("NSIGHT-1 \xe9tude\n".encode("latin-1") + f"{LINE1}\n{LINE2}\n".encode())
     status, out, _ = run(capsys, "lifetime", "--tle", named)
     assert status == 0 and "element set        NSIGHT-1 \xe9tude" in out
+    named.write_bytes(b"NSIGHT\x85 1\n" + f"{LINE1}\n{LINE2}\n".encode())  # cp1252's ellipsis: U+0085 in Latin-1
+    status, out, err = run(capsys, "lifetime", "--tle", named)
+    assert status == 0, err  # it had split the name in two: "line 2: a TLE line has 69 columns, this one 1"
     noise = tmp_path / "noise.tle"
     noise.write_bytes(bytes(range(256)) * 4)
     status, _, err = run(capsys, "lifetime", "--tle", noise)
@@ -115,7 +121,7 @@ def test_fit_density_refuses_a_reentry_before_the_last_observation(tmp_path, cap
     path.write_text(OBSERVATIONS)
     status, _, err = run(capsys, "fit-density", path, "--reentry", "100")
     assert status == 2
-    assert "the re-entry (100) comes 40.57 days before the last observation" in err and "line 5" in err
+    assert "the re-entry (100) is not after the last observation (" in err and "line 5" in err
     status, out, _ = run(capsys, "fit-density", path, "--reentry", "200")
     assert status == 0 and "density scale" in out
 
@@ -155,7 +161,6 @@ ORBIT = ["lifetime", "--perigee", "300", "--apogee", "400"]
         (["--mass", "1e-300", "--area", "1"], "--mass / --area 1e-300 is out of range; allowed: 0.01 to 100000"),
         # "must be a positive integer" for 0, "an integer 10 to 1000000" for 1.
         (["--uncertainty", "--samples", "0"], "--samples 0 is out of range; allowed: an integer 10 to 1000000"),
-        (["--inclination", "98"], "--inclination changes nothing under --atmosphere paper"),
         (["--atmosphere", "msis", "--daily-ap"], "--daily-ap chooses a dated decay's Ap: it goes with --epoch"),
     ],
 )
@@ -231,6 +236,9 @@ def test_options_that_change_nothing_with_element_sets_are_refused(capsys, tmp_p
     path.write_text(f"{LINE1}\n{LINE2}\n")
     status, _, err = run(capsys, "lifetime", "--tle", path, "--drag-from", "ndot", "--mass", "10", "--area", "1")
     assert status == 2 and "--drag-from chooses what an element set's drag is read from" in err
+    assert "the satellite given (--mass, --area)" in err
+    status, _, err = run(capsys, "lifetime", "--tle", path, "--drag-from", "ndot", "--cx", "2.2")
+    assert status == 2 and "the satellite given (--cx) flies its own drag" in err
     batch = tmp_path / "batch.csv"
     batch.write_text("perigee_km,apogee_km\n300,400\n")
     argv = ["lifetime", "--batch", batch, "--out", tmp_path / "o.csv", "--semi-major-axis-km", "6800"]
@@ -247,3 +255,32 @@ def test_a_batch_of_histories_shows_its_drag_fits_progress(tmp_path, capsys):
     assert status == 0 and "drag: 100%" in err and "1/1" in err
     status, _, err = run(capsys, "lifetime", "--batch", path, "--out", tmp_path / "p.csv", "--no-progress")
     assert status == 0 and err == ""
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--semi-major-axis-km", "6778", "--eccentricity", "0.001"],  # J2's shift to the orbit flown
+        ["--perigee", "400", "--apogee", "420", "--atmosphere", "exponential"],  # equatorial heights to geodetic
+    ],
+)
+def test_the_inclination_is_taken_in_still_air_where_it_changes_the_life(capsys, argv):
+    # A refusal of --inclination in still uniform air (a review's wish) had left these at 0 degrees.
+    satellite = ["--mass", "100", "--area", "1", "--json"]
+    lives = []
+    for inclination in ("0", "97"):
+        status, out, _ = run(capsys, "lifetime", *argv, *satellite, "--inclination", inclination)
+        assert status == 0
+        lives.append(json.loads(out)["days"])
+    assert lives[1] > 1.05 * lives[0]  # measured: 181.70 -> 238.82 days, 206.51 -> 245.86 at 90 deg
+
+
+def test_a_re_entry_day_may_be_the_day_of_the_last_observation(tmp_path, capsys):
+    # A day-only date is the whole day: a last tracking that afternoon had been called "after" the re-entry.
+    path = tmp_path / "obs.csv"
+    path.write_text("date,perigee_km,apogee_km\n2020-01-01,350,700\n2020-03-01,340,620\n2020-05-20T14:00,300,400\n")
+    argv = ["fit-density", path, "--atmosphere", "paper", "--mass", "100", "--area", "1", "--reentry"]
+    status, out, err = run(capsys, *argv, "2020-05-20")
+    assert status == 0 and "density scale" in out, err
+    status, _, err = run(capsys, *argv, "2020-05-20T12:00")
+    assert status == 2 and "is not after the last observation" in err
