@@ -13,7 +13,6 @@ pytest.importorskip("stable_baselines3")
 
 import torch
 from stable_baselines3 import PPO
-from stable_baselines3.common.callbacks import BaseCallback
 
 from orbit_env.agents.train import TrainingInterrupted, newest_checkpoint, train
 from orbit_env.cli import main
@@ -189,25 +188,12 @@ def test_every_number_of_a_training_config_has_its_range():
 # --------------------------------------------------------------------------------------
 
 
-class StopAt(BaseCallback):
-    """Ctrl-C at the ``calls``-th vector step (16 make a rollout of 128 timesteps in `TINY`)."""
-
-    def __init__(self, calls: int) -> None:
-        super().__init__()
-        self.calls = calls
-
-    def _on_step(self) -> bool:
-        if self.n_calls == self.calls:
-            raise KeyboardInterrupt
-        return True
-
-
 def policy_of(path):
     """A saved model's policy parameters."""
     return PPO.load(path, device="cpu").policy.state_dict()
 
 
-def test_checkpoints_are_taken_between_rollouts_and_named_by_the_steps_learned(tmp_path):
+def test_checkpoints_are_taken_between_rollouts_and_named_by_the_steps_learned(tmp_path, ctrl_c_at):
     # Checkpoints every 64 timesteps in rollouts of 128: SB3's way had saved inside a rollout, a policy not
     # updated on the steps its name counted (a kill at 20 s of a 10M-step rollout left rl_model_4000000 of
     # an untrained policy, which the next command offered to resume, skipping 4M steps of training).
@@ -226,7 +212,7 @@ def test_checkpoints_are_taken_between_rollouts_and_named_by_the_steps_learned(t
     # Stopped inside its first rollout, the run keeps step 0, and that is what the next command offers to resume.
     stopped = tmp_path / "stopped"
     with pytest.raises(TrainingInterrupted) as stop:
-        train(config, stopped, total_timesteps=256, progress=False, extra_callbacks=[StopAt(12)])
+        train(config, stopped, total_timesteps=256, progress=False, extra_callbacks=[ctrl_c_at(12)])
     assert stop.value.timesteps == 0 and newest_checkpoint(stopped) == stop.value.checkpoint
     with pytest.raises(ValueError, match=r"continue it with --resume .*rl_model_0_steps\.zip"):
         train(config, stopped, total_timesteps=256, progress=False)

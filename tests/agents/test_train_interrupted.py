@@ -19,7 +19,6 @@ import pytest
 pytest.importorskip("stable_baselines3")
 
 from stable_baselines3 import PPO
-from stable_baselines3.common.callbacks import BaseCallback
 
 from orbit_env.agents.train import TrainingInterrupted, newest_checkpoint, train
 from orbit_env.cli import main
@@ -46,19 +45,6 @@ reward = true
 """
 
 
-class StopAt(BaseCallback):
-    """Ctrl-C at the ``calls``-th vector step (16 make a rollout of 128 timesteps here)."""
-
-    def __init__(self, calls: int) -> None:
-        super().__init__()
-        self.calls = calls
-
-    def _on_step(self) -> bool:
-        if self.n_calls == self.calls:
-            raise KeyboardInterrupt
-        return True
-
-
 @pytest.fixture
 def config(tmp_path):
     path = tmp_path / "tiny.toml"
@@ -66,10 +52,10 @@ def config(tmp_path):
     return path
 
 
-def test_an_interrupted_run_keeps_its_last_whole_rollout_and_resumes(config, tmp_path):
+def test_an_interrupted_run_keeps_its_last_whole_rollout_and_resumes(config, tmp_path, ctrl_c_at):
     out = tmp_path / "run"
     with pytest.raises(TrainingInterrupted) as stop:
-        train(config, out, progress=False, extra_callbacks=[StopAt(20)])  # 160 timesteps collected
+        train(config, out, progress=False, extra_callbacks=[ctrl_c_at(20)])  # 160 timesteps collected
     assert stop.value.timesteps == 128 and stop.value.checkpoint == out / "checkpoints" / "rl_model_128_steps.zip"
     assert PPO.load(stop.value.checkpoint, device="cpu").num_timesteps == 128
     assert (out / "checkpoints" / "rl_model_vecnormalize_128_steps.pkl").is_file()
@@ -151,12 +137,12 @@ def test_sigterm_stops_training_as_ctrl_c_does(config, tmp_path):
     assert settings["total_timesteps"] == 1000000
 
 
-def test_a_resume_continues_its_runs_budget_and_settings_whatever_out_is(config, tmp_path):
+def test_a_resume_continues_its_runs_budget_and_settings_whatever_out_is(config, tmp_path, ctrl_c_at):
     # A plain --resume had trained on to the TOML's budget (256 here) instead of the run's (--timesteps 384), and
     # the settings were those of --out's folder, not of the checkpoint's run.
     out = tmp_path / "run"
     with pytest.raises(TrainingInterrupted) as stop:
-        train(config, out, total_timesteps=384, progress=False, extra_callbacks=[StopAt(20)])
+        train(config, out, total_timesteps=384, progress=False, extra_callbacks=[ctrl_c_at(20)])
     with pytest.raises(ValueError, match=r"is of a run trained with other settings \(seed differ"):
         train(config, tmp_path / "elsewhere", seed=5, resume=stop.value.checkpoint, progress=False)
     done = train(config, out, resume=stop.value.checkpoint, progress=False)
