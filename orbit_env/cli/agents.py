@@ -10,7 +10,16 @@ from pathlib import Path
 from typing import Any
 
 from orbit_env.checks import check_int
-from orbit_env.cli.common import PROG, check_figure, check_output, output_file, positive_int
+from orbit_env.cli.common import (
+    PROG,
+    check_figure,
+    check_output,
+    flag,
+    given,
+    output_file,
+    output_folder,
+    positive_int,
+)
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_EVAL_SPLIT, SOLAR_SPLITS
 
 
@@ -32,9 +41,9 @@ def _cmd_train(args: argparse.Namespace) -> int:
             progress=not args.no_progress,
         )
     except TrainingInterrupted as stop:
-        given = [("--config", args.config), ("--timesteps", args.timesteps), ("--seed", args.seed)]
-        given += [("--n-envs", args.n_envs), ("--env", args.env), ("--out", args.out), ("--resume", stop.checkpoint)]
-        again = " ".join(f"{flag} {shlex.quote(str(value))}" for flag, value in given if value is not None)
+        typed = [("--config", args.config), ("--timesteps", args.timesteps), ("--seed", args.seed)]
+        typed += [("--n-envs", args.n_envs), ("--env", args.env), ("--out", args.out), ("--resume", stop.checkpoint)]
+        again = " ".join(f"{option} {shlex.quote(str(value))}" for option, value in typed if value is not None)
         if Path(args.out, "model.zip").exists():  # an interrupted resume of a finished run replaces it again
             again += " --force"
         print(
@@ -73,7 +82,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
 
     check_int(args.seed, "seed", low=0)  # before the model's load and the DP's solve
     if args.no_dp and not args.certify:  # (--certify names --no-dp itself)
-        dp_flags = [_flag(name) for name in ("dp_lookahead", "dp_rollout") if _given(args, name)]
+        dp_flags = [flag(name) for name in ("dp_lookahead", "dp_rollout") if given(args, name)]
         if dp_flags:
             raise ValueError(f"--no-dp leaves the DP policy out: it takes no {' or '.join(dp_flags)}")
     _solar_options(args, args.env in SOLAR_ENV_IDS)
@@ -84,7 +93,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
         names = ("model", "plot", "no_dp", "returns", "name")
-        refused = [_flag(name) for name in names if _given(args, name)]
+        refused = [flag(name) for name in names if given(args, name)]
         if refused:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(refused)}")
         return _certify(args, say)
@@ -122,23 +131,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _given(args: argparse.Namespace, name: str) -> bool:
-    """Whether the option ``name`` was given: a value (an empty one too) or a switch on."""
-    return getattr(args, name) not in (None, False)
-
-
-def _flag(name: str) -> str:
-    return f"--{name.replace('_', '-')}"
-
-
 def _solar_options(args: argparse.Namespace, solar: bool) -> None:
     """Refuse the options of one kind of env given for the other (they would do nothing); fill in the defaults."""
     only_solar = ("solar_split", "disposal_years", "workers")
-    given = [_flag(name) for name in only_solar if getattr(args, name) is not None]
-    if not solar and given:
-        verb = "applies" if len(given) == 1 else "apply"
+    solar_flags = [flag(name) for name in only_solar if getattr(args, name) is not None]
+    if not solar and solar_flags:
+        verb = "applies" if len(solar_flags) == 1 else "apply"
         raise ValueError(
-            f"{', '.join(given)} {verb} to the solar task only (OrbitRaisingSolar-v0 and its continuous twin), "
+            f"{', '.join(solar_flags)} {verb} to the solar task only (OrbitRaisingSolar-v0 and its continuous twin), "
             f"not to {args.env}"
         )
     if solar and args.dp_lookahead is not None:
@@ -311,13 +311,6 @@ def _cmd_curves(args: argparse.Namespace) -> int:
     return 0
 
 
-def _folder(text: str) -> str:
-    """The argparse type of an output folder: not empty (an empty path is the current folder, never meant)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("an empty path; give a folder")
-    return text
-
-
 def _row_name(text: str) -> str:
     """The argparse type of a table row's name: not blank (the row would have no name to read)."""
     if not text.strip():
@@ -330,7 +323,11 @@ def add_parsers(sub: Any) -> None:
     tr = sub.add_parser("train", help="train PPO on the vector environment (config file: agents/ppo.toml)")
     tr.add_argument("--config", metavar="TOML", help="hyperparameter file (default: the shipped agents/ppo.toml)")
     tr.add_argument(
-        "--out", type=_folder, default="runs/ppo", metavar="DIR", help="logs, checkpoints, model.zip (default runs/ppo)"
+        "--out",
+        type=output_folder,
+        default="runs/ppo",
+        metavar="DIR",
+        help="logs, checkpoints, model.zip (default runs/ppo)",
     )
     tr.add_argument(
         "--timesteps", type=positive_int, metavar="N", help="override total_timesteps (rounded up to whole rollouts)"
@@ -427,7 +424,11 @@ def add_parsers(sub: Any) -> None:
     sw.add_argument("--seeds", type=positive_int, default=5, metavar="N", help="seeds 0..N-1 (default 5)")
     sw.add_argument("--timesteps", type=positive_int, default=100_000, metavar="T", help="per trial")
     sw.add_argument(
-        "--out", type=_folder, required=True, metavar="DIR", help="results.json, the models, Ray's state (resumable)"
+        "--out",
+        type=output_folder,
+        required=True,
+        metavar="DIR",
+        help="results.json, the models, Ray's state (resumable)",
     )
     sw.add_argument(
         "--address", metavar="RAY_ADDRESS", help="a running Ray cluster (default: a local Ray; local: a new one)"
@@ -473,7 +474,7 @@ def add_parsers(sub: Any) -> None:
     )
     cu.add_argument("--workers", type=positive_int, default=1, metavar="N", help="runs at once (default 1)")
     cu.add_argument(
-        "--out", type=_folder, required=True, metavar="DIR", help="the runs' curves and results.json (resumable)"
+        "--out", type=output_folder, required=True, metavar="DIR", help="the runs' curves and results.json (resumable)"
     )
     cu.add_argument("--plot", type=output_file, metavar="PNG", help="draw the curves")
     cu.add_argument("--json", action="store_true", help="print results.json's content")

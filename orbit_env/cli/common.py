@@ -234,6 +234,13 @@ def output_file(text: str) -> str:
 output_file.__name__ = "file name"  # argparse says "invalid file name value: ..." if it ever falls through
 
 
+def output_folder(text: str) -> str:
+    """The argparse type of an output folder: not empty (an empty path is the current folder, never meant)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder")
+    return text
+
+
 def positive_int(text: str) -> int:
     """The argparse type of counts: an integer >= 1."""
     value = int(text)
