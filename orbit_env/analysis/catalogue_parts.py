@@ -125,9 +125,39 @@ def run_in_parts(
     folder = parts_folder(out)
     folder.mkdir(exist_ok=True)
     with _owned(folder, out):
-        return _run_owned(
-            out, folder, key, n_rows, rows_per_chunk, compute, workers, address, progress, restart, report
+        bounds = [(start, min(start + rows_per_chunk, n_rows)) for start in range(0, n_rows, rows_per_chunk)]
+        done, deleted = _found_parts(folder, key, len(bounds), restart)
+        missing = [k for k in range(len(bounds)) if k not in done]
+        processes = max(1, min(workers, len(missing)))
+        report(
+            f"{n_rows} rows in {len(bounds)} chunks of up to {rows_per_chunk}"
+            + (f", {len(done)} already in {folder}" if done else "")
+            + (f" ({deleted} part{'s' if deleted > 1 else ''} of another run deleted)" if deleted else "")
+            + (f"; Ray at {address}" if address else f"; {processes} worker{'s' if processes > 1 else ''}")
         )
+        rows_done = sum(bounds[k][1] - bounds[k][0] for k in done)
+        from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
+
+        with tqdm(total=n_rows, initial=rows_done, disable=not progress, unit="row", desc="lifetimes") as bar:
+
+            def keep(k: int, records: Records) -> None:
+                write_records(_part_path(folder, key, k), records)
+                bar.update(len(records))
+
+            chunks = [(k, *bounds[k]) for k in missing]
+            if address:
+                _run_ray(compute, chunks, address, keep)
+            elif processes == 1:
+                for k, start, stop in chunks:
+                    keep(k, compute(start, stop))
+            else:
+                _run_pool(compute, chunks, processes, keep)
+        joined = _join(out, [_part_path(folder, key, k) for k in range(len(bounds))], replace=restart)
+        for k in range(len(bounds)):
+            _part_path(folder, key, k).unlink()
+        (folder / LOCK_NAME).unlink(missing_ok=True)
+        folder.rmdir()
+        return joined
 
 
 #: The lock file of a parts folder: held by the command computing into it.
@@ -153,55 +183,6 @@ def _owned(folder: Path, out: str | Path) -> Iterator[None]:
                 "it), then run this one again"
             ) from None
         yield
-
-
-def _run_owned(
-    out: str | Path,
-    folder: Path,
-    key: str,
-    n_rows: int,
-    rows_per_chunk: int,
-    compute: Compute,
-    workers: int,
-    address: str | None,
-    progress: bool,
-    restart: bool,
-    report: Callable[[str], None],
-) -> JoinedParts:
-    """`run_in_parts` in a parts folder this command holds."""
-    bounds = [(start, min(start + rows_per_chunk, n_rows)) for start in range(0, n_rows, rows_per_chunk)]
-    done, deleted = _found_parts(folder, key, len(bounds), restart)
-    missing = [k for k in range(len(bounds)) if k not in done]
-    processes = max(1, min(workers, len(missing)))
-    report(
-        f"{n_rows} rows in {len(bounds)} chunks of up to {rows_per_chunk}"
-        + (f", {len(done)} already in {folder}" if done else "")
-        + (f" ({deleted} part{'s' if deleted > 1 else ''} of another run deleted)" if deleted else "")
-        + (f"; Ray at {address}" if address else f"; {processes} worker{'s' if processes > 1 else ''}")
-    )
-    rows_done = sum(bounds[k][1] - bounds[k][0] for k in done)
-    from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
-
-    with tqdm(total=n_rows, initial=rows_done, disable=not progress, unit="row", desc="lifetimes") as bar:
-
-        def keep(k: int, records: Records) -> None:
-            write_records(_part_path(folder, key, k), records)
-            bar.update(len(records))
-
-        chunks = [(k, *bounds[k]) for k in missing]
-        if address:
-            _run_ray(compute, chunks, address, keep)
-        elif processes == 1:
-            for k, start, stop in chunks:
-                keep(k, compute(start, stop))
-        else:
-            _run_pool(compute, chunks, processes, keep)
-    joined = _join(out, [_part_path(folder, key, k) for k in range(len(bounds))], replace=restart)
-    for k in range(len(bounds)):
-        _part_path(folder, key, k).unlink()
-    (folder / LOCK_NAME).unlink(missing_ok=True)
-    folder.rmdir()
-    return joined
 
 
 def _run_pool(
