@@ -21,7 +21,7 @@ from typing import Any
 from orbit_env import cache
 from orbit_env.checks import InputError
 from orbit_env.cli import agents, lifetime, paper, solar
-from orbit_env.cli.common import FLAGS, PROG, Parser, flag, in_flags
+from orbit_env.cli.common import FLAGS, PROG, Parser, in_files, in_flags
 
 __all__ = ["FLAGS", "PROG", "build_parser", "main"]
 
@@ -41,19 +41,6 @@ def build_parser() -> Parser:
             help=f"neither read nor write the disk cache of curves and profiles ({cache.ENV_VAR}=off does the same)",
         )
     return parser
-
-
-#: The commands' positional arguments that name files (fit-density's OBS_CSV, solar update's FILE).
-POSITIONALS = ("observations", "file")
-
-
-def _in_files(error: Exception, args: object) -> str:
-    """An error's text; a file that cannot be read named with the flag it came from (``--tle x.tle: ...``)."""
-    if not (isinstance(error, OSError) and error.filename and error.strerror):
-        return str(error)
-    name = next((key for key, value in vars(args).items() if isinstance(value, str) and value == error.filename), None)
-    where = f"{flag(name)} " if name and name not in POSITIONALS else ""  # a positional argument has no flag
-    return f"{where}{error.filename}: {error.strerror.lower()}"
 
 
 def _show_warning(default: Callable[..., None], message: Any, category: type[Warning], *rest: Any, **kw: Any) -> None:
@@ -98,7 +85,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (ValueError, ImportError, OSError) as error:
-        text = in_flags(error, args) if isinstance(error, InputError) else _in_files(error, args)
+        text = in_flags(error, args) if isinstance(error, InputError) else in_files(error, args)
         message = text.splitlines()[0] if text else type(error).__name__
         print(f"{PROG}: error: {message}", file=sys.stderr)
         return 2

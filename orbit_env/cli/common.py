@@ -222,6 +222,19 @@ def _height_shift_km(error: InputError, args: argparse.Namespace, typed: Any) ->
     return -offset if offset and checked_sphere else 0.0
 
 
+#: The commands' positional arguments that name files (fit-density's OBS_CSV, solar update's FILE).
+POSITIONALS = ("observations", "file")
+
+
+def in_files(error: Exception, args: object) -> str:
+    """An error's text; a file that cannot be read or written named with its flag (``--tle x.tle: ...``)."""
+    if not (isinstance(error, OSError) and error.filename and error.strerror):
+        return str(error)
+    name = next((key for key, value in vars(args).items() if isinstance(value, str) and value == error.filename), None)
+    where = f"{flag(name)} " if name and name not in POSITIONALS else ""  # a positional argument has no flag
+    return f"{where}{error.filename}: {error.strerror.lower()}"
+
+
 def output_file(text: str) -> str:
     """The argparse type of a file to write: a name, not an empty one nor ``-`` (no output goes to stdout)."""
     if not text.strip():

@@ -39,6 +39,7 @@ from orbit_env.cli.common import (
     check_output,
     flag,
     given,
+    in_files,
     number,
     output_file,
     positive_int,
@@ -315,8 +316,8 @@ def _lifetime_batch(args: argparse.Namespace, satellite: Satellite, scenario: Sc
                 why = "stopped"
             elif isinstance(stop, BrokenProcessPool):
                 why = f"a worker process died ({stop})"
-            else:  # a full disk: the file named, and what was kept said
-                why = f"error: {stop.filename}: {(stop.strerror or '').lower()}" if stop.filename else f"error: {stop}"
+            else:  # a full disk: the file named, as any command's file errors, and what was kept said
+                why = f"error: {in_files(stop, args)}"
             print(
                 f"{PROG}: {why}; the finished chunks are kept in {parts_folder(args.out)}: the same command "
                 "resumes from them",
