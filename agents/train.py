@@ -25,6 +25,8 @@ import numpy as np
 
 try:
     from stable_baselines3.common.callbacks import BaseCallback
+    from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
+    from stable_baselines3.common.utils import get_latest_run_id
     from stable_baselines3.common.vec_env import VecEnvWrapper
 except ImportError as error:  # pragma: no cover - depends on the installation
     raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
@@ -36,6 +38,8 @@ from orbit_env.checks import check_int
 
 #: The hyperparameter file of the shipped model.
 DEFAULT_CONFIG = "ppo.toml"
+#: The run's tensorboard logs are in ``tensorboard/ppo_1/`` (SB3 numbers a log name's runs).
+TB_LOG_NAME = "ppo"
 #: A run's files beside ``checkpoints/`` and ``tensorboard/`` (``--force`` deletes them with the checkpoints).
 _RUN_FILES = ("model.zip", "best_model.zip", "best_model_replaced.zip", "evaluations.json", "config.json")
 
@@ -616,6 +620,28 @@ def newest_checkpoint(out_dir: str | Path) -> Path | None:
     return max(found)[1] if found else None
 
 
+class _ResumedTensorBoard(TensorBoardOutputFormat):
+    """SB3's tensorboard output whose writer hides the events logged before it at and after ``purge_step``."""
+
+    def __init__(self, folder: str, purge_step: int) -> None:  # the base's two attributes, its writer purging
+        from torch.utils.tensorboard import SummaryWriter
+
+        self.writer = SummaryWriter(log_dir=folder, purge_step=purge_step)
+        self._is_closed = False
+
+
+def resumed_logger(tensorboard: Path, timesteps: int) -> Logger:
+    """The logger of a run resumed at ``timesteps``: its tensorboard folder continued, its later events hidden.
+
+    A run killed past its last checkpoint (SIGKILL, a crash), or resumed from an older checkpoint, had logged
+    the timesteps it then trains again, and TensorBoard drew both (each curve doubling back on itself). The
+    writer's ``purge_step`` hides the earlier events after the checkpoint's timesteps (those at them were
+    logged by the rollouts the checkpoint holds). The folder is the one SB3 continues (``ppo_N``, the newest).
+    """
+    run = tensorboard / f"{TB_LOG_NAME}_{max(get_latest_run_id(str(tensorboard), TB_LOG_NAME), 1)}"
+    return Logger(folder=str(run), output_formats=[_ResumedTensorBoard(str(run), timesteps + 1)])
+
+
 def _vecnormalize_path(checkpoint: Path) -> Path:
     """The reward statistics `save_checkpoint` writes beside ``rl_model_N_steps.zip`` (SB3's own naming)."""
     return checkpoint.with_name(checkpoint.name.replace("rl_model_", "rl_model_vecnormalize_")).with_suffix(".pkl")
@@ -738,6 +764,7 @@ def train(
     if checkpoint is not None:
         model = PPO.load(checkpoint, env=venv, device="cpu", tensorboard_log=str(out / "tensorboard"))
         model.set_random_seed((seed + int(model.num_timesteps)) % (MAX_SEED + 1))
+        model.set_logger(resumed_logger(out / "tensorboard", int(model.num_timesteps)))
     else:
         model = _new_model(PPO, torch, config, venv, out)
     model.orbit_env = {"env_id": config["env_id"], "env": dict(config["env"])}  # saved with the model
@@ -769,7 +796,7 @@ def train(
             model.learn(
                 total_timesteps=remaining,
                 callback=[*callbacks, *([bar] if bar is not None else [])],
-                tb_log_name="ppo",
+                tb_log_name=TB_LOG_NAME,
                 reset_num_timesteps=checkpoint is None,
             )
         if best is not None and (not best.evaluations or best.evaluations[-1]["timesteps"] != model.num_timesteps):

@@ -70,6 +70,25 @@ def test_an_interrupted_run_keeps_its_last_whole_rollout_and_resumes(config, tmp
     assert done.timesteps == 256 and done.trained == 128 and newest_checkpoint(out).name == "rl_model_256_steps.zip"
 
 
+def test_a_resumed_runs_tensorboard_curves_do_not_double_back(config, tmp_path):
+    # A run resumed from a checkpoint older than its last logs (SIGKILL, a crash, an older checkpoint chosen)
+    # had logged 384 and 512 twice: TensorBoard drew each curve back to 256 and on again.
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    config.write_text(TINY.replace("total_timesteps = 256", "total_timesteps = 512"))
+    out = tmp_path / "run"
+    train(config, out, progress=False)
+    train(config, out, resume=out / "checkpoints" / "rl_model_256_steps.zip", force=True, progress=False)
+    assert [p.name for p in (out / "tensorboard").iterdir()] == ["ppo_1"]  # the run's one folder, continued
+    logs = EventAccumulator(str(out / "tensorboard" / "ppo_1"))
+    logs.Reload()
+    for tag in logs.Tags()["scalars"]:  # each curve once along the timesteps
+        steps = [event.step for event in logs.Scalars(tag)]
+        assert steps == sorted(set(steps)), tag
+    for tag in ("rollout/ep_rew_mean", "mission/return"):  # logged after every rollout, by both runs
+        assert [event.step for event in logs.Scalars(tag)] == [128, 256, 384, 512], tag
+
+
 def test_force_starts_over_without_the_old_runs_files(config, tmp_path):
     out = tmp_path / "run"
     train(config, out, progress=False)
