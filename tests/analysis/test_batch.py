@@ -239,9 +239,11 @@ def test_batch_in_many_blocks_keeps_the_input_order(capsys, tmp_path, monkeypatc
         assert float(record["days"]) == pytest.approx(expected.days, rel=1e-5)
 
 
-def test_a_dated_batch_counts_its_satellites_as_they_re_enter(capsys, tmp_path, monkeypatch):
+@pytest.mark.parametrize("rule", [[], ["--rule", "0.1"]])
+def test_a_dated_batch_counts_its_satellites_as_they_re_enter(capsys, tmp_path, monkeypatch, rule):
     # The bar stood at 0 for the whole propagation of a dated batch (3 minutes for 2000 rows), then jumped to
-    # the end: it moves now after each chunk, by the satellites re-entered.
+    # the end: it moves now after each chunk, by the satellites re-entered. With --rule it had stood still until
+    # the rule's search ended (its decays are a share each now); 0.1 year: most of these lives are longer.
     pytest.importorskip("pymsis")
     positions = []
 
@@ -268,7 +270,7 @@ def test_a_dated_batch_counts_its_satellites_as_they_re_enter(capsys, tmp_path, 
     sats.write_text("perigee_km,apogee_km,mass_kg,area_m2,cx\n" + "".join(f"{h},{h},400,1,2.2\n" for h in heights))
     status, stdout, _ = run(
         capsys, "lifetime", "--batch", str(sats), "--out", str(tmp_path / "out.csv"), "--atmosphere", "msis",
-        "--solar-csv", str(flux), "--inclination", "51.6",
+        "--solar-csv", str(flux), "--inclination", "51.6", *rule,
     )  # fmt: skip
     assert status == 0, stdout
     assert positions[-1] == 12 and positions == sorted(positions)
