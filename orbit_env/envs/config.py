@@ -239,22 +239,30 @@ CONFIG_FIELDS = tuple(f.name for f in fields(OrbitRaisingConfig))
 DENSITY_FIELDS = tuple(f.name for f in fields(DensityConfig))
 
 
-def _from(cls: type, value: Any, name: str, overrides: Mapping[str, Any]) -> Any:
-    """``value`` (None, an instance of ``cls`` or a mapping of its fields) with ``overrides`` applied."""
+def from_fields(cls: type, value: Any, name: str, overrides: Mapping[str, Any], default: Any = None) -> Any:
+    """``value`` (None, an instance of ``cls`` or a mapping of its fields) with ``overrides`` applied.
+
+    ``default``: an instance of ``cls`` whose fields stand where ``value`` is None or a mapping does
+    not give them (else the class's defaults).
+
+    Raises:
+        ValueError: ``value`` of another type, or a mapping with a key that is not a field (named, with the valid ones).
+    """
     valid = [f.name for f in fields(cls)]
+    start = {} if default is None else {key: getattr(default, key) for key in valid}
     if value is None:
-        base: dict[str, Any] = {}
+        base: dict[str, Any] = start
     elif isinstance(value, cls):
         base = {key: getattr(value, key) for key in valid}
     elif isinstance(value, Mapping):
         unknown = [key for key in value if key not in valid]
         if unknown:
             raise ValueError(f"{name} has the unknown key {unknown[0]!r}; valid keys: {', '.join(valid)}")
-        base = dict(value)
+        base = {**start, **value}
     else:
         raise ValueError(f"{name}={value!r} is invalid; allowed: a {cls.__name__}, a dict of its fields, or None")
-    if value is not None and not overrides and isinstance(value, cls):
-        return value
+    if not overrides and isinstance(value if value is not None else default, cls):
+        return value if value is not None else default
     return cls(**{**base, **overrides})
 
 
@@ -284,6 +292,6 @@ def resolve_task_arguments(
     config_overrides = {key: value for key, value in keywords.items() if key in CONFIG_FIELDS}
     density_overrides = {key: value for key, value in keywords.items() if key in DENSITY_FIELDS}
     return (
-        _from(OrbitRaisingConfig, config, "config", config_overrides),
-        _from(DensityConfig, density, "density", density_overrides),
+        from_fields(OrbitRaisingConfig, config, "config", config_overrides),
+        from_fields(DensityConfig, density, "density", density_overrides),
     )

@@ -129,7 +129,7 @@ class OrbitRaisingEnv(TaskView, gym.Env[np.ndarray, Any]):
 
     | Key               | Meaning                                                         |
     |-------------------|-----------------------------------------------------------------|
-    | ``reentered``     | bool: the satellite has re-entered (equals ``terminated``)      |
+    | ``reentered``     | bool: the satellite has re-entered (``terminated`` at re-entry or the horizon) |
     | ``days_in_orbit`` | days in orbit since the start (the mission time; at re-entry,   |
     |                   | the exact life); the return is this less the propellant's cost |
     | ``dv_used_m_s``   | delta-v burnt since the start [m/s], the sum of ``burn_m_s``    |

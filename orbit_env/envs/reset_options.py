@@ -71,14 +71,9 @@ def resolve_options(
         # The config's satellite and draws from its ranges, both checked when the config was made:
         # every automatic reset, where the checks would cost ten times the rest.
         return merged
-    shape = () if size is None else (size,)
     for name, value in options.items():
-        array = np.asarray(value, dtype=np.float64) if not isinstance(value, (str, bytes)) else None
-        if array is None or (array.shape != () and array.shape != shape):
-            raise ValueError(f"reset option {name}={value!r} must be a number or an array of shape {shape}")
-        if not np.all(np.isfinite(array)):
-            raise ValueError(f"reset option {name}={value!r} must be finite")
-        merged[name] = float(array) if array.shape == () else array.copy()  # a number pins every satellite
+        array = option_array(name, value, size)
+        merged[name] = float(array) if array.shape == () else array  # a number pins every satellite
     if "perigee_km" in options and "apogee_km" not in options:
         # A pinned perigee above the drawn apogee makes the drawn orbit circular.
         merged["apogee_km"] = np.maximum(merged["apogee_km"], merged["perigee_km"])
@@ -110,6 +105,27 @@ def resolve_options(
     )
     check_array(merged["density_scale"], "density_scale", low=0.0, low_inclusive=False)
     return merged
+
+
+def option_array(name: str, value: Any, size: int | None) -> np.ndarray:
+    """A numeric reset option checked: finite numbers, one or an array of shape ``(size,)`` (a copy).
+
+    ``size`` None: a single environment's, a number only.
+
+    Raises:
+        ValueError: text, a bool, a complex number, another shape, or a value not finite (named).
+    """
+    shape = () if size is None else (size,)
+    try:
+        given = np.asarray(value)
+    except ValueError:  # a ragged sequence
+        given = np.asarray(None)
+    if given.dtype.kind not in "iuf" or given.shape not in ((), shape):
+        raise ValueError(f"reset option {name}={value!r} must be a number or an array of shape {shape}")
+    array = given.astype(np.float64)  # a copy: later changes to the caller's array do not move the start
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"reset option {name}={value!r} must be finite")
+    return array
 
 
 def check_curve_point(label: Any, tau: Any, curves: UniversalCurves) -> None:

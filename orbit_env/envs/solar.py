@@ -19,7 +19,7 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from orbit_env.envs import ENDED_WARNING, solar_task
-from orbit_env.envs.config import OrbitRaisingConfig
+from orbit_env.envs.config import OrbitRaisingConfig, from_fields
 from orbit_env.envs.solar_task import SOLAR_CONFIG, SOLAR_OBS_NAMES, SolarMission, SolarTask
 from orbit_env.envs.state import ROW, BatchState
 from orbit_env.envs.vector import batch_seed
@@ -48,14 +48,9 @@ def solar_task_of(config: OrbitRaisingConfig | dict[str, Any] | None, keywords: 
     if unknown:
         valid = sorted({"config", "continuous", "render_mode", *mission_fields, *config_fields})
         raise ValueError(f"unknown keyword {unknown[0]!r}; valid keywords: {', '.join(valid)}")
-    base = SOLAR_CONFIG if config is None else config
-    if isinstance(base, dict):
-        base = dataclasses.replace(SOLAR_CONFIG, **base)
-    if not isinstance(base, OrbitRaisingConfig):
-        raise ValueError(f"config={config!r} is invalid; allowed: an OrbitRaisingConfig, a dict of its fields or None")
     overrides = {k: v for k, v in keywords.items() if k in config_fields}
+    config = from_fields(OrbitRaisingConfig, config, "config", overrides, default=SOLAR_CONFIG)
     mission = SolarMission(**{k: v for k, v in keywords.items() if k in mission_fields})
-    config = dataclasses.replace(base, **overrides) if overrides else base
     task = SolarTask(config=config, mission=mission, continuous=bool(continuous))
     _ = task.start_window  # the mission must fit its split of the record: a ValueError now, not at reset()
     return task

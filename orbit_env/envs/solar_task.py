@@ -42,6 +42,7 @@ from orbit_env.decay.solar import iso_date, unix_days
 from orbit_env.envs import DISPOSAL_YEARS, SOLAR_SPLITS, solar_kernel
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig
+from orbit_env.envs.reset_options import check_curve_point, option_array
 from orbit_env.envs.state import STALE_SEGMENT, BatchState
 from orbit_env.envs.task import (
     LIFETIME_SCALE_DAYS,
@@ -261,6 +262,13 @@ def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping
     unknown = set(options) - set(SOLAR_START_OPTIONS)
     if unknown:
         raise ValueError(f"unknown reset option(s) {sorted(unknown)}; allowed: {', '.join(SOLAR_START_OPTIONS)}")
+    if "start_date" in options and "start_day" in options:
+        raise ValueError("reset options start_date and start_day both pin the start; give one")
+    options.update({name: option_array(name, value, size) for name, value in options.items() if name != "start_date"})
+    if "start_date" in options and np.shape(options["start_date"]) not in ((), (size,)):
+        raise ValueError(
+            f"reset option start_date={options['start_date']!r} must be a date or an array of shape {(size,)}"
+        )
     config, mission = task.config, task.mission
     first, last = task.start_window
     day = rng.integers(first, last + 1, size).astype(np.float64)
@@ -311,8 +319,8 @@ def start(task: SolarTask, rng: np.random.Generator, size: int, options: Mapping
             raise ValueError(
                 "reset options ['curve_label', 'curve_tau'] and ['perigee_km', 'apogee_km'] both pin the orbit"
             )
-        label = np.broadcast_to(np.asarray(options["curve_label"], dtype=np.float64), (size,))
-        tau = np.broadcast_to(np.asarray(options["curve_tau"], dtype=np.float64), (size,))
+        check_curve_point(options["curve_label"], options["curve_tau"], task.curves)
+        label, tau = np.broadcast_arrays(options["curve_label"], options["curve_tau"], np.empty(size))[:2]
         hp, ha, period = task.curves.at(label, tau)
         state.label, state.tau, state.period_s = label, tau, period
         state.nu = NU_REF * np.expm1(tau)

@@ -125,6 +125,8 @@ class Task:
             raise ValueError(f"config={self.config!r} is invalid; allowed: an OrbitRaisingConfig")
         if not isinstance(self.density, DensityConfig):
             raise ValueError(f"density={self.density!r} is invalid; allowed: a DensityConfig")
+        if not isinstance(self.continuous, (bool, np.bool_)):  # "false" is truthy: it had made the Box variant
+            raise ValueError(f"continuous={self.continuous!r} is invalid; allowed: True or False")
         object.__setattr__(self, "continuous", bool(self.continuous))
 
     def __getstate__(self) -> dict[str, Any]:
@@ -187,10 +189,10 @@ class Task:
             one = action.item()  # the action space's own form, without numpy calls on a 1-element array
             if one == one:  # False for NaN
                 return self.config.max_burn_m_s * min(max(one, 0.0), 1.0)
-        typed = isinstance(action, (str, bytes, bool, np.bool_)) or getattr(action, "dtype", None) == np.bool_
+        typed = np.asarray(action).dtype.kind not in "iuf"  # text, bools, complex numbers (the imaginary part dropped)
         value = np.array(np.nan) if typed else np.asarray(action, dtype=np.float64)
         if value.shape not in ((), (1,)) or np.isnan(value).any():
-            raise ValueError(f"action={action!r} is invalid; allowed: one number, not NaN (clipped to [-1, 1])")
+            raise ValueError(f"action={action!r} is invalid; allowed: one real number, not NaN (clipped to [-1, 1])")
         return self.config.max_burn_m_s * min(max(float(value.reshape(())), 0.0), 1.0)
 
     def requested_dvs(self, actions: Any, n: int) -> FloatArray:
@@ -211,8 +213,11 @@ class Task:
                 bad = (a < 0) | (a >= sizes.size)
                 raise ValueError(f"action {a[bad][0].item()!r} is invalid; allowed: integers in [0, {sizes.size - 1}]")
             return sizes.take(a)
-        if a.shape not in ((n, 1), (n,)):
-            raise ValueError(f"actions of shape {a.shape} are invalid; allowed: shape ({n}, 1) or ({n},)")
+        if a.shape not in ((n, 1), (n,)) or a.dtype.kind not in "iuf":
+            raise ValueError(
+                f"actions of shape {a.shape} and dtype {a.dtype} are invalid; "
+                f"allowed: real numbers of shape ({n}, 1) or ({n},)"
+            )
         a = a.reshape(n).astype(np.float64)
         if np.isnan(a).any():
             raise ValueError("action nan is invalid; allowed: numbers, not NaN (clipped to [-1, 1])")

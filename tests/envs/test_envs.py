@@ -651,8 +651,10 @@ def test_random_configs_keep_the_vector_state_physical(config, density, continuo
         ("OrbitRaising-v0", -1, r"action=-1 is invalid"),
         ("OrbitRaising-v0", 1.0, r"action=1.0 is invalid"),
         ("OrbitRaising-v0", True, r"action=True is invalid"),
-        ("OrbitRaisingContinuous-v0", np.array([np.nan], dtype=np.float32), r"allowed: one number, not NaN"),
-        ("OrbitRaisingContinuous-v0", np.zeros(2, dtype=np.float32), r"allowed: one number, not NaN"),
+        ("OrbitRaisingContinuous-v0", np.array([np.nan], dtype=np.float32), r"allowed: one real number, not NaN"),
+        ("OrbitRaisingContinuous-v0", np.zeros(2, dtype=np.float32), r"allowed: one real number, not NaN"),
+        # A complex action had its imaginary part dropped (the review of the Gymnasium conventions).
+        ("OrbitRaisingContinuous-v0", np.array([0.5 + 1j]), r"allowed: one real number, not NaN"),
     ],
 )
 def test_invalid_actions_raise_value_errors(env_id, action, message):
@@ -673,6 +675,15 @@ def test_invalid_vector_actions_raise_value_errors():
     continuous.reset(seed=0)
     with pytest.raises(ValueError, match=r"action nan is invalid; allowed: numbers, not NaN"):
         continuous.step(np.array([[0.0], [np.nan]]))
+    with pytest.raises(ValueError, match=r"dtype complex128 are invalid; allowed: real numbers of shape \(2, 1\)"):
+        continuous.step(np.array([[0.0], [0.5 + 1j]]))
+
+
+@pytest.mark.parametrize("env_id", ["OrbitRaising-v0", "OrbitRaisingSolar-v0"])
+def test_continuous_must_be_a_bool(env_id):
+    # "false" is truthy: it had made the Box variant (the review of the Gymnasium conventions).
+    with pytest.raises(ValueError, match=r"continuous='false' is invalid; allowed: True or False"):
+        gym.make(env_id, continuous="false")
 
 
 @pytest.mark.parametrize(

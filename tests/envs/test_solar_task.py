@@ -353,12 +353,41 @@ def test_the_vector_env_restarts_on_the_next_step() -> None:
         ({"curve_label": 1.0}, r"reset option curve_label needs \['curve_label', 'curve_tau'\] together"),
         ({"curve_tau": 1.0}, r"reset option curve_tau needs \['curve_label', 'curve_tau'\] together"),
         ({"curve_label": -5.0, "curve_tau": 5.0, "perigee_km": 400.0}, r"both pin the orbit"),
+        # A review of the Gymnasium conventions (2026-12-06) found the rest unchecked: the first two gave
+        # NaN observations outside the observation space and NaN rewards, tau < 0 a mission begun re-entered,
+        # the dates' pair dropped start_day silently, text and bools were read as numbers.
+        ({"curve_label": -13.6, "curve_tau": 1e6}, r"curve_tau=1000000.0 are at perigee 1136.339 km, .* outside"),
+        ({"curve_label": 1e9, "curve_tau": 15.0}, r"curve_label=1000000000 is out of range; allowed: -20.7"),
+        ({"curve_label": -16.3, "curve_tau": -5.0}, r"curve_tau=-5 is out of range; allowed: at least 0"),
+        ({"curve_label": float("nan"), "curve_tau": 1.0}, r"reset option curve_label=nan must be finite"),
+        ({"start_date": "1990-01-01", "start_day": 500.0}, r"start_date and start_day both pin the start"),
+        ({"perigee_km": "450"}, r"reset option perigee_km='450' must be a number"),
+        ({"perigee_km": True}, r"reset option perigee_km=True must be a number"),
+        ({"start_date": ["1990-01-01", "1990-01-02"]}, r"start_date=\['1990-01-01', '1990-01-02'\] must be a date"),
     ],
 )
-def test_half_a_curve_point_is_refused_naming_what_is_missing(options, named) -> None:
-    # It was a bare KeyError: 'curve_tau'.
+def test_a_bad_start_is_refused_naming_it(options, named) -> None:
+    # Half a curve point was a bare KeyError: 'curve_tau'.
     with pytest.raises(ValueError, match=named):
         gym.make(SOLAR_ENV_ID).reset(seed=0, options=options)
+
+
+def test_the_solar_vector_envs_bad_option_shape_is_named() -> None:
+    # It was numpy's "operands could not be broadcast together".
+    env = gym.make_vec(SOLAR_ENV_ID, num_envs=3)
+    with pytest.raises(
+        ValueError,
+        match=r"reset option perigee_km=array\(\[300., 400.\]\) must be a number or an array of shape \(3,\)",
+    ):
+        env.reset(seed=0, options={"perigee_km": np.array([300.0, 400.0])})
+
+
+def test_the_solar_config_as_a_dict_is_checked_and_keeps_the_solar_satellite() -> None:
+    # An unknown key was a TypeError from dataclasses.replace.
+    with pytest.raises(ValueError, match=r"config has the unknown key 'nope'; valid keys: drag_coefficient"):
+        gym.make(SOLAR_ENV_ID, config={"nope": 1})
+    config = gym.make(SOLAR_ENV_ID, config={"horizon_steps": 12}).unwrapped.task.config
+    assert config == dataclasses.replace(orbit_env.envs.solar_task.SOLAR_CONFIG, horizon_steps=12)
 
 
 def test_the_vector_envs_same_step_autoreset_is_gymnasiums_sync_vector_envs() -> None:
