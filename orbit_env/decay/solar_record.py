@@ -26,13 +26,15 @@ downloaded at run time.
   its days have no 3-hourly ap, and a decay takes NRLMSIS's daily-Ap mode on them;
 * ``kind``: ``o`` observed, ``d`` CelesTrak's 45-day daily forecast, ``m`` its monthly
   forecast (NOAA SWPC's predicted cycle; rows placed on the 15th, interpolated linearly).
-  The monthly forecast carries no Ap: its days take the observed Ap of the same day one
-  repeat period earlier (below), which keeps storms in their measured proportion.
+  The monthly forecast carries no Ap: its days take the observed Ap (and 3-hourly ap) of the
+  day one repeat period earlier (below, `RecordActivity.ap_days`), which keeps storms in their
+  measured proportion. (Its rows' ``ap`` column holds the Ap of their own day so taken.)
 
 **After the forecast** the last solar cycle repeats (STK's convention): a day t past the
-last row takes the values of t - P, P being the length of solar cycle 24, from the
-minimum of December 2008 to that of December 2019 (the NASA/NOAA Solar Cycle 25
-Prediction Panel's dates), 4017 days. Before the first day (1957-10-01) the first row is held.
+last row takes the values of t - P (its Ap, as the monthly forecast's, that of an observed
+day), P being the length of solar cycle 24, from the minimum of December 2008 to that of
+December 2019 (the NASA/NOAA Solar Cycle 25 Prediction Panel's dates), 4017 days. Before the
+first day (1957-10-01) the first row is held.
 """
 
 from __future__ import annotations
@@ -109,19 +111,41 @@ class RecordActivity:
         past = np.maximum(np.ceil((t - self.end_days) / self.repeat_days), 0.0)
         return t - past * self.repeat_days
 
+    @property
+    def ap_end_days(self) -> float:
+        """The last day with an Ap of its own: observed, or CelesTrak's daily forecast."""
+        return float(self.table.days[self.kind != "m"][-1])
+
+    def ap_days(self, days: ArrayLike) -> FloatArray:
+        """The days whose Ap (and 3-hourly ap) ``days`` take: past `ap_end_days`, back by whole repeat periods.
+
+        The monthly forecast and the repeated cycle after it take the observed Ap of the day one
+        period earlier (two, past that period's end), so that a forecast month keeps that month's
+        storms and quiet days in their measured proportion and order.
+        """
+        t = np.asarray(days, dtype=np.float64)
+        back = np.maximum(np.ceil((t - self.ap_end_days) / self.repeat_days), 0.0)
+        return t - back * self.repeat_days
+
     def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """F10.7, its 81-day mean and Ap at unix days (the record, its forecast, then the last cycle again)."""
-        return self.table.indices(self.folded_days(days))
+        """F10.7, its 81-day mean and Ap at unix days (the record, its forecast, then the last cycle again).
+
+        The Ap past the observations and the daily forecast is that of `ap_days` (a monthly row's
+        Ap had been one day's, drawn from one period earlier and spread over the month around it by
+        the interpolation: Ap 44 through a July 2028 whose days a cycle before averaged 9).
+        """
+        f107, f107a, _ = self.table.indices(self.folded_days(days))
+        return f107, f107a, self.table.indices(self.ap_days(days))[2]
 
     def ap_history(self, days: ArrayLike) -> FloatArray:
         """The 3-hourly ap that NRLMSIS's storm-time mode reads on each of ``days``' (Unix) calendar days.
 
         Shape (days, 27): from the slot 57 h before the day's first (the sixth of three days
         before) to the day's last, oldest first (`orbit_env.physics.atmosphere.msis.ap_histories`
-        makes each slot's history of them). Past the record's end the day one repeat period
-        earlier, as `indices`. NaN where any of them is not in the record.
+        makes each slot's history of them). Past the observations and the daily forecast, the day
+        whose Ap `indices` reads (`ap_days`). NaN where any of them is not in the record.
         """
-        day = np.floor(self.folded_days(np.atleast_1d(np.asarray(days, dtype=np.float64))))
+        day = np.floor(self.ap_days(np.atleast_1d(np.asarray(days, dtype=np.float64))))
         out = np.full((day.size, 27), np.nan)
         if self.ap3 is None:
             return out
@@ -233,8 +257,9 @@ def parse_celestrak(path: str | Path, base: RecordActivity | None = None) -> Rec
         base_eights = np.full((base.table.days.size, 8), np.nan) if base.ap3 is None else base.ap3
         eights = np.concatenate([base_eights[keep], eights])
         kinds = np.concatenate([base.kind[keep], kinds])
-    # Forecast months without Ap take the Ap of one repeat period earlier, in time order, so a month
-    # more than a period past the observations reads an already filled month.
+    # Forecast months without Ap: the column holds their own day's Ap one repeat period earlier, in time
+    # order, so a month more than a period past the observations reads an already filled month (the
+    # days between the rows take their own, `RecordActivity.ap_days`).
     for i in np.flatnonzero(np.isnan(ap_daily)):
         filled = np.flatnonzero(~np.isnan(ap_daily[:i]))
         ap_daily[i] = np.interp(t[i] - REPEAT_PERIOD_DAYS, t[filled], ap_daily[filled])

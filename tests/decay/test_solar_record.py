@@ -78,6 +78,22 @@ def test_parsing_shifts_bursts_and_fills_the_forecast(tmp_path):
     assert record.observed_end_days == days[2] and record.era(days[3]) == "forecast"
 
 
+def test_the_monthly_forecast_takes_the_daily_ap_of_one_cycle_earlier():
+    # A monthly row's Ap had been one day's of one period earlier, spread over the month around it by the
+    # interpolation (a review, 2026-12-06: Ap 44 through July 2028, whose days a cycle earlier averaged 9.1;
+    # a 330 x 340 km life from 2028-06-20 of 49.0 days, 58.8 under the days' own Ap).
+    record = load_record()
+    assert record.ap_end_days == unix_days("2026-08-14")  # CelesTrak's 45-day daily forecast's last day
+    july = unix_days("2028-07-01") + np.arange(31.0)
+    np.testing.assert_array_equal(record.indices(july)[2], record.indices(july - REPEAT_PERIOD_DAYS)[2])
+    assert record.era(float(july[0])) == "forecast" and record.era(float(july[0] - REPEAT_PERIOD_DAYS)) == "observed"
+    # F10.7 and its mean stay the forecast's own (its monthly rows, interpolated).
+    assert record.indices(july)[0][0] != record.indices(july - REPEAT_PERIOD_DAYS)[0][0]
+    # The 45 days of CelesTrak's daily forecast keep their own Ap.
+    daily = (record.kind == "d") & (record.table.days > record.observed_end_days)
+    np.testing.assert_array_equal(record.indices(record.table.days[daily])[2], record.table.ap[daily])
+
+
 def test_after_the_forecast_the_last_cycle_repeats():
     record = load_record()
     t = record.end_days + np.array([1.0, 400.0, 3000.0, REPEAT_PERIOD_DAYS + 10.0])
@@ -170,10 +186,12 @@ def test_the_shipped_record_holds_celestraks_eight_3_hourly_ap_a_day():
     np.testing.assert_array_equal(
         history[-24:], CELESTRAK_AP3["2003-10-28"] + CELESTRAK_AP3["2003-10-29"] + CELESTRAK_AP3["2003-10-30"]
     )
-    # The monthly forecast has none: its days' histories are unknown (NaN), and a decay keeps the daily Ap.
+    # The monthly forecast has none: its days take the histories of the days one repeat period earlier, as
+    # their daily Ap (storm days keep NRLMSIS's storm-time mode); past the forecast, as the daily indices.
     assert np.all(np.isnan(record.ap3[record.kind == "m"]))
-    assert np.isnan(record.ap_history([record.end_days - 20.0])).all()
-    # Past the forecast, the day one repeat period earlier, as the daily indices.
+    inside = record.end_days - 20.0
+    np.testing.assert_array_equal(record.ap_history([inside]), record.ap_history([inside - REPEAT_PERIOD_DAYS]))
+    assert not np.isnan(record.ap_history([inside])).any()
     late = record.end_days + 100.0
     np.testing.assert_array_equal(record.ap_history([late]), record.ap_history([late - REPEAT_PERIOD_DAYS]))
 
