@@ -192,7 +192,7 @@ def _stepped_spread(
         )
         return reference
 
-    moving = None if bar is None else _rule_progress(_counting(bar, members.size))
+    decays = None if bar is None else _rule_progress(_counting(bar, members.size))
 
     def lifetimes(hp: FloatArray, ha: FloatArray, which: NDArray[np.intp]) -> Any:
         return scenario.lifetime_days(
@@ -202,7 +202,7 @@ def _stepped_spread(
             reference,
             max_days=cap_days,
             own_inclination_deg=own[which],
-            progress=None if moving is None else moving(),
+            progress=None if decays is None else decays(),
         )
 
     _store_check(outputs, members, check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes))

@@ -130,9 +130,8 @@ class RecordActivity:
     def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """F10.7, its 81-day mean and Ap at unix days (the record, its forecast, then the last cycle again).
 
-        The Ap past the observations and the daily forecast is that of `ap_days` (a monthly row's
-        Ap had been one day's, drawn from one period earlier and spread over the month around it by
-        the interpolation: Ap 44 through a July 2028 whose days a cycle before averaged 9).
+        The Ap past the observations and the daily forecast is that of `ap_days`: each day's own, not
+        the monthly rows' interpolated.
         """
         f107, f107a, _ = self.table.indices(self.folded_days(days))
         return f107, f107a, self.table.indices(self.ap_days(days))[2]

@@ -261,8 +261,9 @@ def from_fields(cls: type, value: Any, name: str, overrides: Mapping[str, Any], 
         base = {**start, **value}
     else:
         raise ValueError(f"{name}={value!r} is invalid; allowed: a {cls.__name__}, a dict of its fields, or None")
-    if not overrides and isinstance(value if value is not None else default, cls):
-        return value if value is not None else default
+    given = default if value is None else value
+    if not overrides and isinstance(given, cls):
+        return given
     return cls(**{**base, **overrides})
 
 

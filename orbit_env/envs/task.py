@@ -125,7 +125,7 @@ class Task:
             raise ValueError(f"config={self.config!r} is invalid; allowed: an OrbitRaisingConfig")
         if not isinstance(self.density, DensityConfig):
             raise ValueError(f"density={self.density!r} is invalid; allowed: a DensityConfig")
-        if not isinstance(self.continuous, (bool, np.bool_)):  # "false" is truthy: it had made the Box variant
+        if not isinstance(self.continuous, (bool, np.bool_)):  # a truthy "false" would make the Box variant
             raise ValueError(f"continuous={self.continuous!r} is invalid; allowed: True or False")
         object.__setattr__(self, "continuous", bool(self.continuous))
 
@@ -189,7 +189,7 @@ class Task:
             one = action.item()  # the action space's own form, without numpy calls on a 1-element array
             if one == one:  # False for NaN
                 return self.config.max_burn_m_s * min(max(one, 0.0), 1.0)
-        typed = np.asarray(action).dtype.kind not in "iuf"  # text, bools, complex numbers (the imaginary part dropped)
+        typed = np.asarray(action).dtype.kind not in "iuf"  # text, bools, complex (a cast drops the imaginary part)
         value = np.array(np.nan) if typed else np.asarray(action, dtype=np.float64)
         if value.shape not in ((), (1,)) or np.isnan(value).any():
             raise ValueError(f"action={action!r} is invalid; allowed: one real number, not NaN (clipped to [-1, 1])")
