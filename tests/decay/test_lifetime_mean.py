@@ -14,6 +14,7 @@ STAGE = Satellite(2.2, 1000.0, 10.0)  # an upper stage: 1 t, 10 m^2
 EPOCH = "2026-12-01"
 
 
+@pytest.mark.slow  # 177 s on a cold cache: 80 years of days, the forecast's storm days in storm-time mode
 def test_a_dated_gto_has_a_lifetime_and_a_verdict_from_one_computation():
     life = lifetime(250, 35786, satellite=STAGE, epoch=EPOCH, inclination_deg=28.5, method="curves")
     assert life.reentered and life.method == "averaged"
