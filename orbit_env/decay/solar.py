@@ -201,13 +201,13 @@ class TableActivity:
             "(no record or forecast beyond the table is used)"
         )
 
-    def indices(self, days: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """Indices interpolated at ``days`` (held at the edges)."""
+    def indices(self, days: ArrayLike, ap_days: ArrayLike | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Indices interpolated at ``days`` (held at the edges); the Ap at ``ap_days`` if given."""
         t = np.asarray(days, dtype=np.float64)
         return (
             np.interp(t, self.days, self.f107_sfu),
             np.interp(t, self.days, self.f107a_sfu),
-            np.interp(t, self.days, self.ap),
+            np.interp(t if ap_days is None else np.asarray(ap_days, dtype=np.float64), self.days, self.ap),
         )
 
 

@@ -44,7 +44,7 @@ import math
 import os
 import time
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +111,7 @@ class RecordActivity:
         past = np.maximum(np.ceil((t - self.end_days) / self.repeat_days), 0.0)
         return t - past * self.repeat_days
 
-    @property
+    @cached_property
     def ap_end_days(self) -> float:
         """The last day with an Ap of its own: observed, or CelesTrak's daily forecast."""
         return float(self.table.days[self.kind != "m"][-1])
@@ -133,8 +133,7 @@ class RecordActivity:
         The Ap past the observations and the daily forecast is that of `ap_days`: each day's own, not
         the monthly rows' interpolated.
         """
-        f107, f107a, _ = self.table.indices(self.folded_days(days))
-        return f107, f107a, self.table.indices(self.ap_days(days))[2]
+        return self.table.indices(self.folded_days(days), self.ap_days(days))
 
     def ap_history(self, days: ArrayLike) -> FloatArray:
         """The 3-hourly ap that NRLMSIS's storm-time mode reads on each of ``days``' (Unix) calendar days.
