@@ -147,9 +147,12 @@ def curves(
     Raises:
         ValueError: an algorithm outside `CURVE_ALGOS`, counts below 1, an unknown env.
     """
-    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED
+    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED, TRAIN_EXTRA, missing_learning_libraries
     from orbit_env.agents.sweep import RECIPES, capture_references
 
+    missing = missing_learning_libraries()
+    if missing:  # before any work: the references take seconds, and each curve is a training run
+        raise ImportError(f"learning curves need {' and '.join(missing)}: {TRAIN_EXTRA}")
     for algo in algos:
         if algo not in CURVE_ALGOS:
             raise ValueError(f"unknown algorithm {algo!r}; allowed: {', '.join(CURVE_ALGOS)}")

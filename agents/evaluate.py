@@ -32,6 +32,8 @@ FloatArray = NDArray[np.float64]
 
 #: Episodes whose returns differ by less than this [days] count as ties in the paired comparison.
 TIE_DAYS = 0.01
+#: What installs the learning libraries (stable-baselines3, torch).
+TRAIN_EXTRA = "pip install 'orbit-env[train]'"
 #: The Stable-Baselines3 algorithms ``orbit-env evaluate --model`` loads.
 ALGORITHMS = ("ppo", "a2c", "dqn", "sac", "td3")
 
@@ -410,7 +412,7 @@ def _algorithm_class(algorithm: str) -> Any:
     try:
         import stable_baselines3
     except ImportError as error:  # pragma: no cover - depends on the installation
-        raise ImportError("learned agents need stable-baselines3: pip install 'orbit-env[train]'") from error
+        raise ImportError(f"learned agents need stable-baselines3: {TRAIN_EXTRA}") from error
     return getattr(stable_baselines3, algorithm.upper())
 
 
@@ -446,6 +448,13 @@ def _no_schedule(_progress: float) -> float:
     return 0.0
 
 
+def missing_learning_libraries() -> list[str]:
+    """The learning libraries (torch, stable-baselines3) not installed: the [train] extra's."""
+    from importlib.util import find_spec
+
+    return [name for name in ("torch", "stable_baselines3") if find_spec(name) is None]
+
+
 def load_model(
     env_id: str, model_path: str | Path | None = None, warn: Callable[[str], None] | None = None
 ) -> tuple[str, Predictor] | None:
@@ -473,14 +482,21 @@ def load_model(
 
     if env_id not in SOLAR_ENV_IDS:
         check_env_id(env_id)
+    missing = missing_learning_libraries()
     if model_path is None:
         if env_id not in SHIPPED_MODELS:
+            return None
+        if missing:  # an installation without the [train] extra scores every other row
+            if warn is not None:
+                warn(f"the shipped agent's row is left out: it needs {' and '.join(missing)} ({TRAIN_EXTRA})")
             return None
         path = Path(str(resources.files("orbit_env.agents").joinpath("models", SHIPPED_MODELS[env_id])))
     else:
         path = Path(model_path)
     if not path.is_file():
         raise ValueError(f"no model at {path}")
+    if missing:
+        raise ValueError(f"a learned agent needs {' and '.join(missing)}: {TRAIN_EXTRA}")
     algorithm = model_algorithm(path)
     import torch
     from stable_baselines3.common.save_util import load_from_zip_file

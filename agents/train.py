@@ -206,16 +206,23 @@ def _ppo_schema() -> dict[str, tuple[type | tuple[type, ...], Any]]:
 def load_config(path: str | Path | None = None) -> dict[str, Any]:
     """Read and check a training config (default: the shipped ``agents/ppo.toml``).
 
-    Every key is checked: an unknown key, a wrong type or value, a TOML syntax error
-    or an env id that is not this package's is one ``ValueError`` line naming the
-    file (and the line, for syntax), the key and what is allowed.
+    ``agents/NAME.toml`` (or ``NAME.toml``) that is no file but a shipped recipe's name reads the shipped
+    recipe: the docs write the recipes so, and a command typed outside the repository finds them. Every key
+    is checked: an unknown key, a wrong type or value, a TOML syntax error or an env id that is not this
+    package's is one ``ValueError`` line naming the file (and the line, for syntax), the key and what is
+    allowed.
     """
+    shipped = resources.files("orbit_env.agents")
+    name = DEFAULT_CONFIG if path is None else None
+    given = None if path is None else Path(path)
+    if given is not None and given.parent.name in ("", "agents") and not given.is_file():
+        name = given.name if shipped.joinpath(given.name).is_file() else None
     source = DEFAULT_CONFIG if path is None else str(path)
     try:
-        if path is None:
-            text = resources.files("orbit_env.agents").joinpath(DEFAULT_CONFIG).read_text()
+        if name is not None:
+            text = shipped.joinpath(name).read_text()
         else:
-            text = Path(path).read_text(encoding="utf-8")
+            text = Path(str(path)).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise ValueError(f"cannot read the training config {source}: {error}") from None
     try:

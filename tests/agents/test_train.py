@@ -165,6 +165,26 @@ def test_shipped_configs_pass_the_strict_check(name):
     assert config["total_timesteps"] > 0
 
 
+def test_the_docs_recipe_paths_read_the_shipped_recipes_outside_the_repository(tmp_path, monkeypatch):
+    # The docs write `--config agents/ppo_uncertain.toml`; from another folder (an installed wheel) no such file
+    # exists, and the command had failed "cannot read the training config" (the packaging review, 2026-12-06).
+    monkeypatch.chdir(tmp_path)
+    config = load_config("agents/ppo_uncertain.toml")
+    assert config["env_id"] == "OrbitRaisingUncertain-v0"
+    assert load_config("ppo_solar.toml")["env_id"] == "OrbitRaisingSolar-v0"
+    # A path of another folder, or a name no recipe has, is not replaced: the user's file is missing.
+    for missing in ("mine/ppo.toml", "agents/mine.toml"):
+        with pytest.raises(ValueError, match="cannot read the training config"):
+            load_config(missing)
+    # A file of that name in the working folder is read, not the shipped recipe.
+    (tmp_path / "agents").mkdir()
+    from importlib import resources
+
+    own = resources.files("orbit_env.agents").joinpath("ppo.toml").read_text()  # OrbitRaising-v0's recipe
+    (tmp_path / "agents" / "ppo_uncertain.toml").write_text(own)
+    assert load_config("agents/ppo_uncertain.toml")["env_id"] == "OrbitRaising-v0"
+
+
 def test_budgets_round_up_to_whole_rollouts():
     from orbit_env.agents.train import timesteps_to_train
 
