@@ -15,6 +15,7 @@ import math
 import re
 import time
 import tomllib
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -215,8 +216,10 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     shipped = resources.files("orbit_env.agents")
     name = DEFAULT_CONFIG if path is None else None
     given = None if path is None else Path(path)
-    if given is not None and given.parent.name in ("", "agents") and not given.is_file():
+    if given is not None and given.parent in (Path("."), Path("agents")) and not given.is_file():
         name = given.name if shipped.joinpath(given.name).is_file() else None
+        if name is not None:
+            warnings.warn(f"{given} is no file here: reading the shipped recipe {name}", stacklevel=2)
     source = DEFAULT_CONFIG if path is None else str(path)
     try:
         if name is not None:

@@ -169,11 +169,14 @@ def test_the_docs_recipe_paths_read_the_shipped_recipes_outside_the_repository(t
     # The docs write `--config agents/ppo_uncertain.toml`; from another folder (an installed wheel) no such file
     # exists, and the command had failed "cannot read the training config" (the packaging review, 2026-12-06).
     monkeypatch.chdir(tmp_path)
-    config = load_config("agents/ppo_uncertain.toml")
+    with pytest.warns(UserWarning, match="reading the shipped recipe ppo_uncertain.toml"):
+        config = load_config("agents/ppo_uncertain.toml")
     assert config["env_id"] == "OrbitRaisingUncertain-v0"
-    assert load_config("ppo_solar.toml")["env_id"] == "OrbitRaisingSolar-v0"
-    # A path of another folder, or a name no recipe has, is not replaced: the user's file is missing.
-    for missing in ("mine/ppo.toml", "agents/mine.toml"):
+    with pytest.warns(UserWarning):
+        assert load_config("ppo_solar.toml")["env_id"] == "OrbitRaisingSolar-v0"
+    # A path of another folder (even one named agents), or a name no recipe has, is not replaced: the user's
+    # file is missing.
+    for missing in ("mine/ppo.toml", "agents/mine.toml", str(tmp_path / "elsewhere" / "agents" / "ppo.toml")):
         with pytest.raises(ValueError, match="cannot read the training config"):
             load_config(missing)
     # A file of that name in the working folder is read, not the shipped recipe.
