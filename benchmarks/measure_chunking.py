@@ -13,6 +13,15 @@ orbits and orbits 20 km and 120 km wide: 108 cases, about six minutes. Needs pym
 coarser bins (`orbit_env.decay.chunked.NEAR_CIRCULAR_BIN_STEP`) against the fine bins,
 3U cubesats under the shipped record from seven dates over two solar cycles, circular and
 20 km wide, lives of 2 months to 19 years (co-rotating air, 51.6 deg): 35 cases.
+
+``python benchmarks/measure_chunking.py placement`` prints lives at 20-, 5- and 1-day chunks against the
+daily reference under the shipped record from 2019-01-10 (a quiet Sun whose daily Ap crosses the bins' edges
+often, so that orbits are placed again on a new bin's curves many times): a 3U cubesat at 51.6 deg on a
+circular, a 50 km wide and a 500 km wide orbit; about 4 minutes.
+
+``python benchmarks/measure_chunking.py long`` prints one long life against the daily reference: GRACE's orbit
+as `benchmarks/validate_reentries.py` flies it (483 x 508 km above the equatorial radius, 89 deg, from
+2002-03-17 09:21, c_x A/m = 3.41 x 1.0 m^2 / 487 kg, co-rotating air), about 17 years; about 7 minutes.
 """
 
 import sys
@@ -122,8 +131,46 @@ def near_circular() -> None:
     )
 
 
+def placement() -> None:
+    """Lives at shorter chunks (more placements on a new bin's curves) against the daily reference."""
+    from orbit_env.decay.solar_record import load_record
+
+    record = load_record()
+    start = unix_days("2019-01-10")
+    for hp, ha in ((450e3, 450e3), (450e3, 500e3), (300e3, 800e3)):
+        reference = integrate_reference(hp, ha, C_CUBESAT_M2_KG, SolarDecayModel(record, start, 51.6))
+        lives = []
+        for chunk in (20.0, 5.0, 1.0):
+            model = SolarDecayModel(record, start, 51.6, chunk_days=chunk)
+            days = float(propagate(hp, ha, C_CUBESAT_M2_KG, model).days[0])
+            lives.append(f"{chunk:g} d: {days:.2f} ({days / reference - 1:+.3%})")
+        print(f"{hp / 1e3:.0f} x {ha / 1e3:.0f} km, reference {reference:.2f} days; " + ", ".join(lives), flush=True)
+
+
+def long_life() -> None:
+    """GRACE's 17-year life at the default chunks against the daily reference."""
+    from orbit_env.decay.solar_record import load_record
+
+    start = unix_days("2002-03-17T09:21")
+    model = SolarDecayModel(load_record(), start, 89.0, rotating_atmosphere=True)
+    hp, ha, c = 490.137e3, 515.137e3, 3.41 * 1.0 / 487.0  # heights onto the 6371 km sphere: +7.137 km
+    days = float(propagate(hp, ha, c, model).days[0])
+    t = time.perf_counter()
+    reference = integrate_reference(hp, ha, c, model)
+    print(
+        f"GRACE: {days:.2f} days at 20-day chunks, reference {reference:.2f} ({time.perf_counter() - t:.0f} s): "
+        f"{days / reference - 1:+.2%}"
+    )
+
+
 def main() -> None:
     only = sys.argv[1:]
+    if only == ["placement"]:
+        placement()
+        return
+    if only == ["long"]:
+        long_life()
+        return
     if only == ["short"]:
         short_lives()
         return

@@ -10,7 +10,8 @@ bin's, taken over the orbit as drag weights it (`orbit_ratio`; near re-entry fro
 equations' rates, `orbit_env.decay.density_multiplier.life_rate_ratio`). The satellite moves along its curve by the
 chunk's time (W = Int P dnu falls by dt g c s); near re-entry a chunk goes a day at a time, in
 the last days by the midpoint rule (`FINE_CHUNKS`, `FINISH_STEP_DAYS`, `LAST_DAYS`). Satellites are re-located on the
-curves only when the bin changes; everything is vectorized over satellites.
+curves only when the bin changes, where their heights are (`UniversalCurves.locate_exactly`: table A's point
+alone moved nu at each placement, and the moves added up over many); everything is vectorized over satellites.
 
 Why each choice, and its measured effect against a day-by-day integration of the averaged
 equations (`orbit_env.decay.reference_path.integrate_reference`): docs/validation-modern/solar-activity.md.
@@ -791,8 +792,7 @@ def _propagate(
         new_bin = binned != key_prev
         if new_bin:
             curves = cached_curves(model.bin_model(binned))
-            point = curves.locate(hp[active], ha[active])
-            label, tau = point.label, point.tau
+            label, tau = curves.locate_exactly(hp[active], ha[active])
             key_prev = binned
         assert curves is not None
         if spread is None:
