@@ -163,19 +163,14 @@ def long_life() -> None:
     )
 
 
+#: The studies of their own, by the word that runs them (the module docstring).
+STUDIES = {"placement": placement, "long": long_life, "short": short_lives, "near-circular": near_circular}
+
+
 def main() -> None:
     only = sys.argv[1:]
-    if only == ["placement"]:
-        placement()
-        return
-    if only == ["long"]:
-        long_life()
-        return
-    if only == ["short"]:
-        short_lives()
-        return
-    if only == ["near-circular"]:
-        near_circular()
+    if len(only) == 1 and only[0] in STUDIES:
+        STUDIES[only[0]]()
         return
     start = unix_days("2021-06-01")
     cases = [
