@@ -214,18 +214,15 @@ def load_config(path: str | Path | None = None) -> dict[str, Any]:
     allowed.
     """
     shipped = resources.files("orbit_env.agents")
-    name = DEFAULT_CONFIG if path is None else None
     given = None if path is None else Path(path)
+    name = DEFAULT_CONFIG if given is None else None  # a shipped recipe's, or None: the file ``given``
     if given is not None and given.parent in (Path("."), Path("agents")) and not given.is_file():
-        name = given.name if shipped.joinpath(given.name).is_file() else None
-        if name is not None:
+        if shipped.joinpath(given.name).is_file():
+            name = given.name
             warnings.warn(f"{given} is no file here: reading the shipped recipe {name}", stacklevel=2)
     source = DEFAULT_CONFIG if path is None else str(path)
     try:
-        if name is not None:
-            text = shipped.joinpath(name).read_text()
-        else:
-            text = Path(str(path)).read_text(encoding="utf-8")
+        text = shipped.joinpath(name).read_text() if name is not None else Path(str(given)).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise ValueError(f"cannot read the training config {source}: {error}") from None
     try:

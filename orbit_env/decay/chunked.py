@@ -252,16 +252,21 @@ class SolarDecayModel:
 
     def chunk_condition(self, t_days: float) -> tuple[DailyIndices, tuple[float, float]]:
         """Daily indices (and days of the year) of the chunk starting ``t_days`` after the start, and its bin."""
-        daily = self.daily_indices(self.chunk_samples(t_days))
+        days = self.chunk_samples(t_days)
+        daily = self.daily_indices(days)
         self.prefetch(daily, t_days)
-        return daily, self.chunk_bin(t_days)
+        return daily, self._bin_of(days)
 
     def chunk_bin(self, t_days: float) -> tuple[float, float]:
         """The bin of the chunk starting ``t_days`` after the start: its mean 81-day F10.7 and Ap, binned.
 
         No day's air: what the lifetime's mean air (`orbit_env.decay.lifetime_mean`) reads.
         """
-        _, f107a, ap = self.activity.indices(self.chunk_samples(t_days))
+        return self._bin_of(self.chunk_samples(t_days))
+
+    def _bin_of(self, days: FloatArray) -> tuple[float, float]:
+        """The bin of the chunk sampled at ``days`` (`chunk_samples`)."""
+        _, f107a, ap = self.activity.indices(days)
         return bin_indices(float(np.mean(f107a)), float(np.mean(ap)), self.bin_step, self.ap_bins)
 
     def near_circular(self) -> SolarDecayModel:

@@ -216,9 +216,9 @@ def test_a_decay_reads_no_air_above_its_orbits_own_heights(msis, monkeypatch, tm
 def test_shorter_chunks_converge_on_a_wide_orbit_in_a_quiet_sun():
     # Each chunk whose daily Ap falls in another bin places the orbits again on that bin's curves. From table
     # A's point alone the round trip to table B's heights lost about 2e-4 of nu a placement at 450 x 500 km, and
-    # from 2019-01-10 (a quiet Sun whose daily Ap crosses the bins' edges often) the life at 1-day chunks was
-    # 1.0% shorter at 5-day chunks than at 20-day chunks (1678.9 against 1696.1 days, 1617.2 at 1-day chunks;
-    # the daily reference 1699.5, `benchmarks/measure_chunking.py placement`). Placed by Newton's method on
+    # from 2019-01-10 (a quiet Sun whose daily Ap crosses the bins' edges often) the life was 1.0% shorter at
+    # 5-day chunks than at 20-day chunks (1678.9 against 1696.1 days, 1617.2 at 1-day chunks; the daily
+    # reference 1699.5, `benchmarks/measure_chunking.py placement`). Placed by Newton's method on
     # table B, all are within 0.06% of the reference; 0.1% allowed between them (the bins' own shape error,
     # docs/validation-modern/solar-activity.md).
     from orbit_env.decay.chunked import SolarDecayModel, propagate
