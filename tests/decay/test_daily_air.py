@@ -240,11 +240,12 @@ def direct_row(key, heights_m=HEIGHTS_M, inclination_deg=51.6, latitude_nodes=4,
             ap3[now - 11 : now - 3].mean(),
             ap3[now - 19 : now - 11].mean(),
         ]
-        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(((doy - 1.0) * 24.0 + ut_h) * 3600.0), "s")
+        hours = (doy - 1.0) * 24.0 + ut_h  # a day of the year with a fraction (the year's nodes) moves the slot
+        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(hours * 3600.0), "s")
         n = alts_km.size
         out = pymsis.calculate(
             np.full(n, date),
-            np.repeat(np.mod((local_time - ut_h) * 15.0, 360.0), heights_m.size),
+            np.repeat(np.mod((local_time - hours) * 15.0, 360.0), heights_m.size),  # the samples' local times then
             np.repeat(lat, heights_m.size),
             alts_km.ravel(),
             np.full(n, f107),

@@ -107,6 +107,52 @@ def test_orbit_average_converged():
     assert np.allclose(base, fine, rtol=5e-3)
 
 
+def _day_mean_through_universal_time(heights_m, f107, ap, inclination_deg, day_of_year, node_h):
+    """A day's orbit mean straight from pymsis: 12 x 12 (or 24 orbit points), each at 48 universal times."""
+    pymsis = pytest.importorskip("pymsis")
+    lat, local_time = orbit_samples(inclination_deg, node_h)
+    total = np.zeros(heights_m.size)
+    for ut_h in np.arange(48) * 0.5 + 0.25:
+        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(((day_of_year - 1) * 24 + ut_h) * 3600), "s")
+        n = lat.size * heights_m.size
+        out = pymsis.calculate(
+            np.full(n, date),
+            np.repeat(np.mod((local_time - ut_h) * 15.0, 360.0), heights_m.size),
+            np.repeat(lat, heights_m.size),
+            geodetic_altitude_m(heights_m[None, :], lat[:, None]).ravel() / 1e3,
+            f107s=np.full(n, f107),
+            f107as=np.full(n, f107),
+            aps=np.full((n, 7), ap),
+            version=2.1,
+        )
+        total += np.asarray(out[:, 0], dtype=np.float64).reshape(lat.size, heights_m.size).mean(axis=0)
+    return total / 48.0
+
+
+@pytest.mark.parametrize(
+    ("inclination_deg", "node_h", "f107", "ap", "day_of_year"),
+    [
+        (89.0, None, 70.0, 5.0, 356),  # taken at 12 h UT alone, the mean was 1.2% above at 500 km, 2.5% at 700 km
+        (89.0, None, 70.0, 5.0, 170),
+        (51.6, None, 70.0, 5.0, 356),
+        (28.5, None, 150.0, 30.0, 156),
+        (97.5, 10.5, 70.0, 5.0, 356),
+        (97.5, 18.0, 150.0, 7.0, 156),
+    ],
+)
+def test_a_days_mean_covers_its_universal_times(inclination_deg, node_h, f107, ap, day_of_year):
+    # Over a day a satellite at one local time passes every longitude: the mean is over the day's universal times
+    # too. The package's six-by-six nodes (the days' air table) against 48 universal times at 12 x 12 nodes: 0.5%,
+    # above the worst of 0.31% measured on 40 such days (28.5-97.5 deg, F10.7 70-250, Ap 2-80, 250-1000 km; 0.12%
+    # at 12 x 12 nodes). At one universal time for every sample, as before, the worst was 3.1%.
+    heights_m = np.array([250e3, 400e3, 500e3, 700e3, 1000e3])
+    mean = mean_density_kg_m3(
+        heights_m, f107, f107, ap, inclination_deg, day_of_year, node_h, latitude_nodes=6, local_time_nodes=6
+    )
+    brute = _day_mean_through_universal_time(heights_m, f107, ap, inclination_deg, day_of_year, node_h)
+    np.testing.assert_allclose(mean, brute, rtol=5e-3)
+
+
 @pytest.mark.parametrize(
     ("args", "kwargs", "message"),
     [
