@@ -147,8 +147,9 @@ def curves(
     Raises:
         ValueError: an algorithm outside `CURVE_ALGOS`, counts below 1, an unknown env.
     """
-    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED, TRAIN_EXTRA, missing_learning_libraries
+    from orbit_env.agents.evaluate import EVAL_EPISODES, EVAL_SEED, missing_learning_libraries
     from orbit_env.agents.sweep import RECIPES, capture_references
+    from orbit_env.optional import TRAIN_EXTRA
 
     missing = missing_learning_libraries()
     if missing:  # before any work: the references take seconds, and each curve is a training run

@@ -27,13 +27,12 @@ from orbit_env.agents import EVAL_EPISODES, EVAL_SEED
 from orbit_env.agents.policies import HAND_CODED
 from orbit_env.checks import check_int
 from orbit_env.envs import ENV_IDS, SOLAR_ENV_IDS
+from orbit_env.optional import TRAIN_EXTRA
 
 FloatArray = NDArray[np.float64]
 
 #: Episodes whose returns differ by less than this [days] count as ties in the paired comparison.
 TIE_DAYS = 0.01
-#: What installs the learning libraries (stable-baselines3, torch).
-TRAIN_EXTRA = "pip install 'orbit-env[train]'"
 #: The Stable-Baselines3 algorithms ``orbit-env evaluate --model`` loads.
 ALGORITHMS = ("ppo", "a2c", "dqn", "sac", "td3")
 

@@ -52,10 +52,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from orbit_env.optional import TRAIN_EXTRA
+
 try:
     from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper, VecMonitor
 except ImportError as error:  # pragma: no cover - depends on the installation
-    raise ImportError("reward shaping needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
+    raise ImportError(f"reward shaping needs stable-baselines3 and torch: {TRAIN_EXTRA}") from error
 
 from orbit_env.envs import task as task_model
 from orbit_env.envs.config import OrbitRaisingConfig

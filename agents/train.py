@@ -24,13 +24,15 @@ from typing import Any
 
 import numpy as np
 
+from orbit_env.optional import TRAIN_EXTRA
+
 try:
     from stable_baselines3.common.callbacks import BaseCallback
     from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
     from stable_baselines3.common.utils import get_latest_run_id
     from stable_baselines3.common.vec_env import VecEnvWrapper
 except ImportError as error:  # pragma: no cover - depends on the installation
-    raise ImportError("training needs stable-baselines3 and torch: pip install 'orbit-env[train]'") from error
+    raise ImportError(f"training needs stable-baselines3 and torch: {TRAIN_EXTRA}") from error
 
 from orbit_env.agents import VALIDATION_SEED  # the evaluation callback's (training uses the config's seed)
 from orbit_env.agents.shaping import SHAPINGS

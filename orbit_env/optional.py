@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
+#: What installs the learning libraries (stable-baselines3, torch): the hint of every error that misses them.
+TRAIN_EXTRA = "pip install 'orbit-env[train]'"
+
 
 def pyplot() -> Any:
     """Import matplotlib's pyplot for files (Agg backend), or say which extra to install."""

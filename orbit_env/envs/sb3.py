@@ -25,14 +25,13 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 from orbit_env.envs.vector import OUTCOME_KEYS
+from orbit_env.optional import TRAIN_EXTRA
 
 try:
     from stable_baselines3.common.vec_env import VecEnv, VecMonitor
     from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvStepReturn
 except ImportError as error:  # pragma: no cover - depends on the installation
-    raise ImportError(
-        "orbit_env.envs.sb3 needs stable-baselines3; install it with: pip install 'orbit-env[train]'"
-    ) from error
+    raise ImportError(f"orbit_env.envs.sb3 needs stable-baselines3; install it with: {TRAIN_EXTRA}") from error
 
 
 class SB3VecEnv(VecEnv):
