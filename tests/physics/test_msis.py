@@ -97,14 +97,16 @@ def test_density_responds_to_activity_and_altitude():
     assert np.all(np.diff(MsisAtmosphere(150.0, 150.0, 15.0, 51.6).density_kg_m3(upper)) < 0)
 
 
-def test_orbit_average_converged():
+@pytest.mark.parametrize("inclination_deg", [51.6, 97.5])
+def test_orbit_average_converged(inclination_deg):
     pytest.importorskip("pymsis")
-    h = np.array([200e3, 400e3, 700e3])
-    base = mean_density_kg_m3(h, 150.0, 150.0, 15.0, 51.6)
+    h = np.array([200e3, 400e3, 700e3, 900e3])
+    base = mean_density_kg_m3(h, 150.0, 150.0, 15.0, inclination_deg)
     nodes = {"latitude_nodes": 36, "local_time_nodes": 36, "season_nodes": 18}
-    fine = mean_density_kg_m3(h, 150.0, 150.0, 15.0, 51.6, **nodes)
-    # 0.5%: the node counts are chosen so that the average is far inside NRLMSIS's own ~15%.
-    assert np.allclose(base, fine, rtol=5e-3)
+    fine = mean_density_kg_m3(h, 150.0, 150.0, 15.0, inclination_deg, **nodes)
+    # 0.2%: measured at most 0.1% against 48 x 48 x 24 nodes (200-900 km, three solar conditions); the
+    # average is far inside NRLMSIS's own ~15%. With every sample at 12 h UT it had been 0.4% (1.1% polar).
+    np.testing.assert_allclose(base, fine, rtol=2e-3)
 
 
 def _day_mean_through_universal_time(heights_m, f107, ap, inclination_deg, day_of_year, node_h):

@@ -40,8 +40,8 @@ How the average is taken, and why:
   ``SEASON_NODES`` days spread evenly over the year (the annual and semiannual
   variations, +-30% at 400 km, integrate exactly); a number takes that day.
 
-With 12 x 12 x 6 nodes the average differs from one with 48 x 48 x 24 by less than
-0.4% from 200 to 900 km at 51.6 deg (1.1% at 900 km for a polar orbit), far inside
+With 12 x 12 x 6 nodes the average differs from one with 48 x 48 x 24 by at most
+0.1% from 200 to 900 km at 51.6 and 97.5 deg (F10.7 70-220, Ap 4-30), far inside
 the model's own uncertainty (~15%).
 * **Geometry.** NRLMSIS wants geodetic altitude; the package's altitude is above a
   6371 km sphere. A point at radius R + h and latitude phi has a geodetic altitude
