@@ -48,10 +48,10 @@ def test_a_dated_gto_has_a_lifetime_and_a_verdict_from_one_computation():
 )
 def test_the_mean_air_agrees_with_the_time_stepped_curves_on_long_lives(perigee_km, apogee_km):
     # Inside the curves' domain both paths exist. These two, from 2026-12-01, measured
-    # -3.5% (350 x 1500 km, 11.9 years) and +0.3% (300 x 3900 km, 20.4 years) against the
-    # time-stepped curves (benchmarks/validate_mean_air.py, 2026-12-06); 5% allowed. Over both
-    # epochs of that script, lives of nine years and more are within 4%; shorter ones, which
-    # depend on when in the cycle they end, up to +14% (docs/validation-modern.md, section 8).
+    # -2.2% (350 x 1500 km, 11.8 years) and +2.2% (300 x 3900 km, 20.1 years) against the
+    # time-stepped curves (benchmarks/validate_mean_air.py, 2026-12-07); 5% allowed. Over both
+    # epochs of that script, lives of nine years and more are within 2.2%; shorter ones, which
+    # depend on when in the cycle they end, up to +14.2% (docs/validation-modern.md, section 8).
     # Both in co-rotating air, as the script measures and a dated lifetime has it.
     stepped = lifetime(
         perigee_km,
