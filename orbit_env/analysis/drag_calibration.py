@@ -278,17 +278,20 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     # The model's drop of a from the first set to each set per unit c [m per m^2/kg].
     cumulative = np.concatenate([[0.0], np.cumsum(rate * np.diff(grid) * 86400.0)])
     unit_drop = np.interp(t, grid, cumulative)
-    drop = a_m[0] - a_m
-    # Least squares through the origin, the first set held as the start: drop_k = c unit_drop_k.
-    c = float(np.dot(unit_drop[1:], drop[1:]) / np.dot(unit_drop[1:], unit_drop[1:]))
+    # Least squares of a_k = a_start - c unit_drop_k, the start fitted too: every set's semi-major axis is a
+    # measurement with the same error, the first one's included (held as exact, its error would shift c for
+    # every later set alike). For two sets the line goes through both, as before.
+    centred = unit_drop - unit_drop.mean()
+    c = float(-np.dot(centred, a_m - a_m.mean()) / np.dot(centred, centred))
     if not c > 0.0:
         raise ValueError(
             f"the semi-major axis does not fall between these {len(sets)} sets "
-            f"({(drop[-1]) / 1e3:+.3f} km over {t[-1] - t[0]:.1f} days): a manoeuvre, or too short a span to fit"
+            f"({(a_m[-1] - a_m[0]) / 1e3:+.3f} km over {t[-1] - t[0]:.1f} days): a manoeuvre, "
+            "or too short a span to fit"
         )
     if len(sets) == 2:  # the fit goes through both: no residual to judge it by, so one set's scatter
         return DragFit(c, 2, float(t[-1] - t[0]), None, ONE_SET_DRAG_SIGMA)
-    residual = drop[1:] - c * unit_drop[1:]
+    residual = (a_m - a_m.mean()) + c * centred
     rms = float(np.sqrt(np.sum(residual**2) / (len(sets) - 2)))
-    sigma_c = rms / math.sqrt(float(np.dot(unit_drop[1:], unit_drop[1:])))
+    sigma_c = rms / math.sqrt(float(np.dot(centred, centred)))
     return DragFit(c, len(sets), float(t[-1] - t[0]), rms / 1e3, sigma_c / c)
