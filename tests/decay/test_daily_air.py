@@ -11,8 +11,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pymsis
 import pytest
+from msis_reference import pymsis_orbit_mean
 
 from orbit_env import cache
 from orbit_env.decay import daily_air
@@ -23,11 +23,9 @@ from orbit_env.decay.solar import unix_days
 from orbit_env.decay.solar_record import load_record
 from orbit_env.physics.atmosphere.msis import (
     SEASON_NODES,
-    geodetic_altitude_m,
     mean_density_kg_m3,
     mean_density_over_days_kg_m3,
     orbit_mean_density_by_day_kg_m3,
-    orbit_samples,
 )
 
 HEIGHTS_M = np.array([200e3, 400e3, 700e3])
@@ -227,11 +225,8 @@ def direct_row(key, heights_m=HEIGHTS_M, inclination_deg=51.6, latitude_nodes=4,
         )[0]
     f107, f107a, ap, doy = key[:4]
     ap3 = np.array(key[4:])
-    lat, local_time = orbit_samples(inclination_deg, None, latitude_nodes, local_time_nodes)
-    alts_km = geodetic_altitude_m(heights_m[None, :], lat[:, None]) / 1e3  # (samples, heights)
-    total = np.zeros(heights_m.size)
+    slots = []
     for slot in range(8):
-        ut_h = 1.5 + 3.0 * slot  # the slot's middle
         now = 19 + slot  # the slot's place in the 27
         # pymsis.calculate's docstring: daily Ap; ap now, 3, 6 and 9 h before; means of 12-33 h and 36-57 h before.
         history = [
@@ -240,23 +235,10 @@ def direct_row(key, heights_m=HEIGHTS_M, inclination_deg=51.6, latitude_nodes=4,
             ap3[now - 11 : now - 3].mean(),
             ap3[now - 19 : now - 11].mean(),
         ]
-        hours = (doy - 1.0) * 24.0 + ut_h  # a day of the year with a fraction (the year's nodes) moves the slot
-        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(hours * 3600.0), "s")
-        n = alts_km.size
-        out = pymsis.calculate(
-            np.full(n, date),
-            np.repeat(np.mod((local_time - hours) * 15.0, 360.0), heights_m.size),  # the samples' local times then
-            np.repeat(lat, heights_m.size),
-            alts_km.ravel(),
-            np.full(n, f107),
-            np.full(n, f107a),
-            np.tile(history, (n, 1)),
-            version=2.1,
-            geomagnetic_activity=-1,
-        )
-        # pymsis returns float32: the mean is taken in float64, as the package does.
-        total += np.asarray(out[:, 0], dtype=np.float64).reshape(lat.size, heights_m.size).mean(axis=0)
-    return total / 8.0
+        slots.append((1.5 + 3.0 * slot, history))  # the slot's middle
+    return pymsis_orbit_mean(
+        heights_m, inclination_deg, None, doy, f107, f107a, slots, latitude_nodes, local_time_nodes
+    )
 
 
 def test_a_storm_days_row_is_nrlmsis_storm_time_mode_through_its_slots(tmp_path, monkeypatch):

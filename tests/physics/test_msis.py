@@ -5,6 +5,7 @@ import sys
 
 import numpy as np
 import pytest
+from msis_reference import pymsis_orbit_mean
 
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
@@ -109,28 +110,6 @@ def test_orbit_average_converged(inclination_deg):
     np.testing.assert_allclose(base, fine, rtol=2e-3)
 
 
-def _day_mean_through_universal_time(heights_m, f107, ap, inclination_deg, day_of_year, node_h):
-    """A day's orbit mean straight from pymsis: 12 x 12 (or 24 orbit points), each at 48 universal times."""
-    pymsis = pytest.importorskip("pymsis")
-    lat, local_time = orbit_samples(inclination_deg, node_h)
-    total = np.zeros(heights_m.size)
-    for ut_h in np.arange(48) * 0.5 + 0.25:
-        date = np.datetime64("2001-01-01T00:00") + np.timedelta64(round(((day_of_year - 1) * 24 + ut_h) * 3600), "s")
-        n = lat.size * heights_m.size
-        out = pymsis.calculate(
-            np.full(n, date),
-            np.repeat(np.mod((local_time - ut_h) * 15.0, 360.0), heights_m.size),
-            np.repeat(lat, heights_m.size),
-            geodetic_altitude_m(heights_m[None, :], lat[:, None]).ravel() / 1e3,
-            f107s=np.full(n, f107),
-            f107as=np.full(n, f107),
-            aps=np.full((n, 7), ap),
-            version=2.1,
-        )
-        total += np.asarray(out[:, 0], dtype=np.float64).reshape(lat.size, heights_m.size).mean(axis=0)
-    return total / 48.0
-
-
 @pytest.mark.parametrize(
     ("inclination_deg", "node_h", "f107", "ap", "day_of_year"),
     [
@@ -151,7 +130,9 @@ def test_a_days_mean_covers_its_universal_times(inclination_deg, node_h, f107, a
     mean = mean_density_kg_m3(
         heights_m, f107, f107, ap, inclination_deg, day_of_year, node_h, latitude_nodes=6, local_time_nodes=6
     )
-    brute = _day_mean_through_universal_time(heights_m, f107, ap, inclination_deg, day_of_year, node_h)
+    # 12 x 12 nodes (or 24 orbit points), each at 48 universal times.
+    slots = [(ut_h, ap) for ut_h in np.arange(48) * 0.5 + 0.25]
+    brute = pymsis_orbit_mean(heights_m, inclination_deg, node_h, day_of_year, f107, f107, slots)
     np.testing.assert_allclose(mean, brute, rtol=5e-3)
 
 
