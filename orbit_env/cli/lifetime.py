@@ -248,7 +248,14 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if args.plot:
         from orbit_env.analysis.plots import plot_history
 
-        plot_history(result, args.plot, activity=scenario.activity, height_offset_km=offset, band_days=band)
+        plot_history(
+            result,
+            args.plot,
+            activity=scenario.activity,
+            height_offset_km=offset,
+            band_days=band,
+            observed=orbit_inputs.history_points(args, orbit, result.epoch_days),
+        )
     if args.json:
         summary["atmosphere"] = _atmosphere(args, scenario, result=result)
         print(_json(summary))

@@ -61,6 +61,43 @@ def test_trajectory_and_plot_files(capsys, tmp_path):
     assert png_path.stat().st_size > 10_000
 
 
+def test_a_history_plot_draws_its_element_sets_where_the_decay_starts_from_the_latest(capsys, tmp_path, monkeypatch):
+    # BEESAT-4's last four sets (benchmarks/data/reentry_tles): the plot's points are the sets' orbits flown,
+    # on the decay's heights and days, so the latest sits on the decay's first point.
+    from pathlib import Path
+
+    import orbit_env.analysis.plots as plots
+    from orbit_env.analysis.elements import read_tle
+
+    source = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "reentry_tles" / "41619_beesat4.tle"
+    tle = tmp_path / "beesat4.tle"
+    tle.write_text("\n".join(source.read_text().split("\n")[-9:]))  # the last four sets (and the file's end)
+    sets = read_tle(tle)
+    assert len(sets) == 4
+    drawn = {}
+    real = plots.plot_history
+
+    def spy(result, path, **keywords):
+        drawn.update(keywords, result=result)
+        return real(result, path, **keywords)
+
+    monkeypatch.setattr(plots, "plot_history", spy)
+    for air in ("msis", "paper"):  # dated: days from the epoch; the paper's undated air: from the latest set
+        png = tmp_path / f"{air}.png"
+        status, out, _ = run(capsys, "lifetime", "--tle", str(tle), "--atmosphere", air, "--plot", str(png), "--json")
+        assert status == 0 and png.stat().st_size > 10_000
+        summary, result = json.loads(out), drawn["result"]
+        days, perigee, apogee = (np.array(column) for column in zip(*drawn["observed"], strict=True))
+        # Days from the decay's start: the latest set's epoch, which dates the air to the second (1.2e-5 day).
+        np.testing.assert_allclose(days, [s.epoch_days - sets[-1].epoch_days for s in sets], rtol=0, atol=1.2e-5)
+        # The latest set's point is the decay's start, in the heights the plot draws (above the equator).
+        offset = drawn["height_offset_km"]
+        assert perigee[-1] == pytest.approx(result.history.perigee_km[0] - offset, abs=1e-6)
+        assert apogee[-1] == pytest.approx(result.history.apogee_km[0] - offset, abs=1e-6)
+        assert (perigee[-1], apogee[-1]) == pytest.approx((summary["perigee_km"], summary["apogee_km"]), abs=1e-6)
+        assert np.all(np.diff(perigee) < 0.0)  # the sets decay
+
+
 def test_table2_json(capsys):
     status, out, _ = run(capsys, "table2", "--json")
     assert status == 0
