@@ -254,7 +254,7 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
             activity=scenario.activity,
             height_offset_km=offset,
             band_days=band,
-            observed=orbit_inputs.history_points(args, orbit, result.epoch_days),
+            observed=orbit_inputs.history_points(args, result.epoch_days),
         )
     if args.json:
         summary["atmosphere"] = _atmosphere(args, scenario, result=result)

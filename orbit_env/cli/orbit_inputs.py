@@ -326,20 +326,18 @@ def history_rows(history: Any, offset: float, epoch_days: float | None = None) -
     return rows
 
 
-def history_points(
-    args: argparse.Namespace, orbit: OrbitInput, start_days: float | None
-) -> list[tuple[float, float, float]]:
+def history_points(args: argparse.Namespace, start_days: float | None) -> list[tuple[float, float, float]]:
     """A ``--tle`` history's sets for `plot_history`'s ``observed``: (days from the start, perigee, apogee [km]).
 
-    The decay starts at ``start_days`` (None: undated, at the latest set). The orbit flown of each set, above
-    the command's height reference, as the decay's heights are drawn; none for one set (the decay's start).
+    The decay starts at ``start_days`` (None: undated, at the latest set). Each set's orbit flown, above the
+    equatorial radius: the reference of every element set's heights (`prepare` refuses another), so drawn as
+    the decay's are; none for one set (the decay's start).
     """
     sets = getattr(args, "tle_history", None) or []
     if not sets:
         return []
     start = sets[-1].epoch_days if start_days is None else start_days
-    shift = offset_km("equatorial") - orbit.offset_km  # the sets' flown heights are above the equator
-    return [(s.epoch_days - start, s.flown_perigee_km + shift, s.flown_apogee_km + shift) for s in sets]
+    return [(s.epoch_days - start, s.flown_perigee_km, s.flown_apogee_km) for s in sets]
 
 
 def read_orbits(args: argparse.Namespace, satellite: Satellite, scenario: Any) -> BatchOrbits:
