@@ -281,8 +281,8 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     # Least squares of a_k = a_start - c unit_drop_k, the start fitted too: every set's semi-major axis is a
     # measurement with the same error, the first one's included (held as exact, its error would shift c for
     # every later set alike). For two sets the line goes through both, as before.
-    centred = unit_drop - unit_drop.mean()
-    c = float(-np.dot(centred, a_m - a_m.mean()) / np.dot(centred, centred))
+    centred, deviation = unit_drop - unit_drop.mean(), a_m - a_m.mean()
+    c = float(-np.dot(centred, deviation) / np.dot(centred, centred))
     if not c > 0.0:
         raise ValueError(
             f"the semi-major axis does not fall between these {len(sets)} sets "
@@ -291,7 +291,7 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
         )
     if len(sets) == 2:  # the fit goes through both: no residual to judge it by, so one set's scatter
         return DragFit(c, 2, float(t[-1] - t[0]), None, ONE_SET_DRAG_SIGMA)
-    residual = (a_m - a_m.mean()) + c * centred
+    residual = deviation + c * centred
     rms = float(np.sqrt(np.sum(residual**2) / (len(sets) - 2)))
     sigma_c = rms / math.sqrt(float(np.dot(centred, centred)))
     return DragFit(c, len(sets), float(t[-1] - t[0]), rms / 1e3, sigma_c / c)
