@@ -72,11 +72,15 @@ print(*times)
 """
 
 
-def run(command: list[str], cache_dir: str) -> tuple[float, str]:
-    """Wall time [s] and standard output of a whole process in the cache ``cache_dir``."""
+def run(command: list[str], cache_dir: str, timeout: float | None = None) -> tuple[float, str]:
+    """Wall time [s] and standard output of a whole process in the cache ``cache_dir``.
+
+    Raises:
+        subprocess.TimeoutExpired: the process ran over ``timeout`` seconds (it is stopped).
+    """
     env = {**os.environ, "ORBIT_ENV_CACHE_DIR": cache_dir}
     start = time.perf_counter()
-    done = subprocess.run(command, check=True, capture_output=True, text=True, env=env)
+    done = subprocess.run(command, check=True, capture_output=True, text=True, env=env, timeout=timeout)
     return time.perf_counter() - start, done.stdout
 
 

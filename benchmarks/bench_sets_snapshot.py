@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
+from bench_dated import run
 
 #: sgp4's gravity constant for the made sets [km^3/s^2] (WGS72's, as `sgp4init` takes them).
 MU_KM3_S2 = 398600.8
@@ -60,15 +59,13 @@ def write_sets(path: Path, objects: int) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def run(command: list[str], cache_dir: str, timeout: float) -> str:
-    """The wall time of a whole process in the cache ``cache_dir``, or that it was stopped."""
-    env = {**os.environ, "ORBIT_ENV_CACHE_DIR": cache_dir}
-    start = time.perf_counter()
+def timed(command: list[str], cache_dir: str, timeout: float) -> str:
+    """The wall time of a whole process in the cache ``cache_dir`` (`bench_dated.run`), or that it was stopped."""
     try:
-        subprocess.run(command, check=True, capture_output=True, text=True, env=env, timeout=timeout)
+        seconds, _ = run(command, cache_dir, timeout)
     except subprocess.TimeoutExpired:
         return f"over {timeout:.0f} s (stopped)"
-    return f"{time.perf_counter() - start:.1f} s"
+    return f"{seconds:.1f} s"
 
 
 def main() -> None:
@@ -83,8 +80,8 @@ def main() -> None:
         command = [sys.executable, "-m", "orbit_env.cli", "lifetime", "--batch", str(sets), "--out", str(out)]
         command += ["--no-progress", "--force"]
         cache_dir = str(Path(folder) / "cache")
-        cold = run(command, cache_dir, args.timeout)
-        warm = run(command, cache_dir, args.timeout)
+        cold = timed(command, cache_dir, args.timeout)
+        warm = timed(command, cache_dir, args.timeout)
         print(f"{args.objects} objects, each at its own epoch: cold {cold}, warm {warm}")
         if out.is_file():
             print(out.read_text(), end="")
