@@ -2,12 +2,15 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from orbit_env.analysis import plots
+from orbit_env.analysis.elements import read_tle
 from orbit_env.analysis.lifetime import Satellite, lifetime, make_satellite
 from orbit_env.cli import main
 
@@ -64,11 +67,6 @@ def test_trajectory_and_plot_files(capsys, tmp_path):
 def test_a_history_plot_draws_its_element_sets_where_the_decay_starts_from_the_latest(capsys, tmp_path, monkeypatch):
     # BEESAT-4's last four sets (benchmarks/data/reentry_tles): the plot's points are the sets' orbits flown,
     # on the decay's heights and days, so the latest sits on the decay's first point.
-    from pathlib import Path
-
-    import orbit_env.analysis.plots as plots
-    from orbit_env.analysis.elements import read_tle
-
     source = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "reentry_tles" / "41619_beesat4.tle"
     tle = tmp_path / "beesat4.tle"
     tle.write_text("\n".join(source.read_text().split("\n")[-9:]))  # the last four sets (and the file's end)
