@@ -5,9 +5,9 @@ for a speed test only (not real objects: `sgp4`'s ``export_tle`` of orbits drawn
 perigee 300-700 km, apogee up to 60 km higher, inclinations 40-98 deg, B* 2e-5 to 5e-4 /ER,
 epochs spread over the two days from 2024-03-01, as a catalogue snapshot's are) and runs, as a
 user does, ``orbit-env lifetime --batch sets.tle --out OUT --no-progress`` twice in a disk cache
-of its own: empty (cold), then warm. Each object starts from its own set's epoch, so each runs
-alone on its own inclination group's curves and days' air (docs/how-to/catalogue.md, "A limit:
-a snapshot of many objects"); a run over ``--timeout`` seconds is stopped and said to be.
+of its own: empty (cold), then warm. Each object starts from its own set's epoch, all in one run
+that each joins at its epoch (docs/how-to/catalogue.md, "A snapshot of many objects"); a run over
+``--timeout`` seconds is stopped and said to be.
 """
 
 from __future__ import annotations

@@ -170,17 +170,20 @@ def _stepped_spread(
     cap_days: float | None,
     outputs: tuple[FloatArray, NDArray[np.bool_], NDArray[np.bool_], FloatArray, FloatArray],
     bar: Any = None,
+    start_days: FloatArray | None = None,
 ) -> float:
     """Lifetimes (and the rule) of ``members`` on the time-stepped path, one family; returns its inclination.
 
     The family is that of the most common inclination group; every row keeps its own
     inclination as a density multiplier (`orbit_env.decay.chunked.propagate`). ``bar`` (tqdm)
-    counts the satellites as they re-enter, and all of them at the end.
+    counts the satellites as they re-enter, and all of them at the end. ``start_days``: each
+    row's start (`batch_lifetimes`).
     """
     perigee_m, apogee_m, drag_parameter_m2_kg, inclination_deg = inputs
     days, reentered = outputs[:2]
     reference = _most_common(group_of[members])
     c, own = drag_parameter_m2_kg[members], inclination_deg[members]
+    start = None if start_days is None else start_days[members]
     if rule_years is None:
         days[members], reentered[members] = scenario.lifetime_days(
             perigee_m[members],
@@ -189,6 +192,7 @@ def _stepped_spread(
             reference,
             own_inclination_deg=own,
             progress=None if bar is None else _counting(bar, members.size),
+            start_days=start,
         )
         return reference
 
@@ -203,6 +207,7 @@ def _stepped_spread(
             max_days=cap_days,
             own_inclination_deg=own[which],
             progress=None if decays is None else decays(),
+            start_days=None if start is None else start[which],
         )
 
     _store_check(outputs, members, check_disposal_rule(perigee_m[members], apogee_m[members], rule_years, lifetimes))
@@ -280,15 +285,19 @@ def batch_lifetimes(
     exact_groups: bool = False,
     epoch_days: FloatArray | None = None,
     bar: Any = None,
+    start_days: FloatArray | None = None,
 ) -> tuple[list[dict[str, Any]], BatchSummary]:
     """Lifetimes (and the rule check) of every valid row; output records in input order.
 
     ``exact_groups`` builds a curve family per inclination group however many there
     are (the reference the one-family path of a spread catalogue is measured against).
     ``epoch_days`` (a dated ``scenario`` only): each row's own start [unix days], the
-    epoch of its object's latest element set; the rows of each date run in the scenario
-    moved to it (`Scenario.at_epoch`), and the records gain ``epoch`` and ``reentry_date``.
-    ``bar``: a progress bar (tqdm) to move instead of one of its own (``progress`` is then unused).
+    epoch of its object's latest element set; the scenario moves to the first of them
+    (`Scenario.at_epoch`), every row starts at its own (``start_days``), and the records
+    gain ``epoch`` and ``reentry_date``. ``start_days`` (a dated ``scenario`` only): each
+    row's start, days after the scenario's epoch: the rows of all dates share the chunks
+    (`orbit_env.decay.chunked.propagate`). ``bar``: a progress bar (tqdm) to move instead of
+    one of its own (``progress`` is then unused).
     """
     if epoch_days is not None:
         return _from_own_epochs(
@@ -328,7 +337,9 @@ def batch_lifetimes(
             members = np.flatnonzero(ok)
             if scenario.time_varying:
                 counted = _counting(bar, members.size)
-                families.add(_stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs, bar))
+                families.add(
+                    _stepped_spread(scenario, members, group_of, inputs, rule_years, cap_days, outputs, bar, start_days)
+                )
                 counted(1.0)
             elif rule_years is None:
                 families.add(_spread_batch(scenario, members, group_of, inputs, days, reentered, bar))
@@ -346,10 +357,16 @@ def batch_lifetimes(
             blocks = [members] if scenario.time_varying else np.array_split(members, max(1, members.size // BLOCK))
             for block in blocks:
                 counted = _counting(bar, block.size)
+                start = None if start_days is None else start_days[block]
                 if rule_years is None:
                     moving = counted if scenario.time_varying else None
                     d, r = scenario.lifetime_days(
-                        perigee_m[block], apogee_m[block], drag_parameter_m2_kg[block], inclination, progress=moving
+                        perigee_m[block],
+                        apogee_m[block],
+                        drag_parameter_m2_kg[block],
+                        inclination,
+                        progress=moving,
+                        start_days=start,
                     )
                     days[block], reentered[block] = d, r
                 else:
@@ -359,7 +376,11 @@ def batch_lifetimes(
                     def lifetimes(hp: FloatArray, ha: FloatArray, which: NDArray[np.intp]) -> Any:
                         moving = None if decays is None else decays()  # noqa: B023
                         c = c_block[which]  # noqa: B023
-                        return scenario.lifetime_days(hp, ha, c, inclination, max_days=cap_days, progress=moving)  # noqa: B023
+                        begin = None if start is None else start[which]  # noqa: B023
+                        angle = inclination  # noqa: B023
+                        return scenario.lifetime_days(
+                            hp, ha, c, angle, max_days=cap_days, progress=moving, start_days=begin
+                        )
 
                     _store_check(
                         outputs, block, check_disposal_rule(perigee_m[block], apogee_m[block], rule_years, lifetimes)
@@ -422,35 +443,23 @@ def _from_own_epochs(
     epoch_days: FloatArray,
     **options: Any,
 ) -> tuple[list[dict[str, Any]], BatchSummary]:
-    """`batch_lifetimes` of the rows of each date in the scenario moved to it; the records in input order."""
-    from tqdm import tqdm  # here, not at the top: a command that runs no catalogue does not import it
+    """`batch_lifetimes` of every row from its own date, in the scenario moved to the first; records in input order.
 
+    The rows of all dates share one run (`batch_lifetimes`'s ``start_days``): a snapshot of element
+    sets at as many epochs as objects costs one catalogue's run, not one per object.
+    """
     from orbit_env.analysis.lifetime import iso_datetime
 
-    progress = options.pop("progress")
-    records: list[dict[str, Any]] = [{} for _ in rows]
-    groups = 0
-    valid = np.array([s == "ok" for s in status])
-    dates = np.unique(epoch_days[valid]) if valid.any() else np.array([])
-    with tqdm(total=int(valid.sum()), disable=not progress, unit="sat", desc="lifetimes") as bar:
-        # Rows with no lifetime to compute go with the first date: their records say why.
-        for k, date in enumerate(dates if dates.size else [np.nan]):
-            members = np.flatnonzero((valid & (epoch_days == date)) | (~valid & (k == 0)))
-            counted = _counting(bar, int(valid[members].sum()))
-            part, summary = batch_lifetimes(
-                [rows[i] for i in members],
-                *(x[members] for x in inputs),
-                [status[i] for i in members],
-                scenario if np.isnan(date) else scenario.at_epoch(float(date)),
-                bar=bar,  # moved by the date's satellites as they re-enter
-                **options,
-            )
-            groups += summary.groups
-            for i, record in zip(members, part, strict=True):
-                days = record.get("days", "")
-                record_date = {"epoch": iso_datetime(float(epoch_days[i])) if np.isfinite(epoch_days[i]) else ""}
-                record_date["reentry_date"] = iso_datetime(float(epoch_days[i]) + float(days)) if days else ""
-                status[i] = record.pop("status")
-                records[i] = {**record, **record_date, "status": status[i]}
-            counted(1.0)
-    return records, BatchSummary(rows=len(rows), ok=sum(s == "ok" for s in status), groups=groups)
+    valid = np.array([s == "ok" for s in status], dtype=bool) & np.isfinite(epoch_days)
+    air, start_days = scenario, None
+    if valid.any():
+        first = float(np.min(epoch_days[valid]))
+        air, start_days = scenario.at_epoch(first), np.where(valid, epoch_days - first, 0.0)
+    records, summary = batch_lifetimes(rows, *inputs, status, air, start_days=start_days, **options)
+    for i, record in enumerate(records):
+        days = record.get("days", "")
+        record_date = {"epoch": iso_datetime(float(epoch_days[i])) if np.isfinite(epoch_days[i]) else ""}
+        record_date["reentry_date"] = iso_datetime(float(epoch_days[i]) + float(days)) if days else ""
+        status_i = record.pop("status")
+        records[i] = {**record, **record_date, "status": status_i}
+    return records, summary

@@ -182,6 +182,7 @@ class Scenario:
         max_days: float | None = None,
         own_inclination_deg: ArrayLike | None = None,
         progress: Callable[[float], None] | None = None,
+        start_days: ArrayLike | None = None,
     ) -> tuple[FloatArray, NDArray[np.bool_]]:
         """Days to re-entry of many satellites (one inclination), and whether they re-enter.
 
@@ -189,12 +190,14 @@ class Scenario:
         chunked curves, stopped after ``max_days`` if given (else ``max_years``);
         with ``own_inclination_deg``, each satellite's inclination on the curves of
         ``inclination_deg`` (`orbit_env.decay.chunked.propagate`), and ``progress``
-        called with the share of them re-entered after each chunk.
+        called with the share of them re-entered after each chunk. ``start_days``: each
+        satellite's start, days after the epoch (its own element set's; time-stepped only): the days
+        (and ``max_days``) count from it.
 
         Raises:
             ValueError: heights invalid or outside the universal curves' domain, a drag parameter or
-                density scale out of range, or ``own_inclination_deg`` on a fixed profile (the
-                catalogue's one-family path serves those).
+                density scale out of range, or ``own_inclination_deg`` or ``start_days`` on a fixed
+                profile (the catalogue's one-family path serves the former; the latter has no date).
         """
         hp, ha = UniversalCurves.check_domain(perigee_m, apogee_m)
         c = check_drag_parameter(drag_parameter_m2_kg)
@@ -202,16 +205,25 @@ class Scenario:
         hp, ha, c, s = np.broadcast_arrays(hp, ha, c, s)
         s = s * self.density_scale
         if not self.time_varying:
-            if own_inclination_deg is not None:
-                raise ValueError("own_inclination_deg applies to the time-stepped path only")
+            if own_inclination_deg is not None or start_days is not None:
+                raise ValueError("own_inclination_deg and start_days apply to the time-stepped path only")
             point = self.curves(inclination_deg).locate(hp, ha)
             days = days_from_weighted_s(point.weighted_s, c, s)
             return days, np.ones(days.shape, dtype=bool)
         model = self.solar_model(
             inclination_deg, None if max_days is None else max(max_days, self.chunk_days) / DAYS_PER_YEAR
         )
-        own = None if own_inclination_deg is None else np.broadcast_to(own_inclination_deg, hp.shape).ravel()
+        own, start = (
+            None if x is None else np.broadcast_to(x, hp.shape).ravel() for x in (own_inclination_deg, start_days)
+        )
         result = propagate(
-            hp.ravel(), ha.ravel(), c.ravel(), model, density_scale=s.ravel(), inclination_deg=own, progress=progress
+            hp.ravel(),
+            ha.ravel(),
+            c.ravel(),
+            model,
+            density_scale=s.ravel(),
+            inclination_deg=own,
+            progress=progress,
+            start_days=start,
         )
         return result.days.reshape(hp.shape), result.reentered.reshape(hp.shape)

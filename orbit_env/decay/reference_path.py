@@ -1,10 +1,10 @@
 """The reference the dated decay is measured against: the averaged equations in time, day by day. SI units.
 
-No bins, no chunks, no curves: the orbit-averaged NRLMSIS profile at each day's indices
-(and day of the year; on the decay's storm days, `orbit_env.decay.chunked.STORM_AP`, NRLMSIS's
-storm-time mode through the day's eight 3-hour slots, as the decay takes them), its logarithm
-interpolated linearly in time, and the averaged
-rates of `orbit_env.decay.averaged` integrated by scipy's DOP853 to re-entry. Slow (about
+No bins, no chunks, no curves: the orbit-averaged NRLMSIS profile at each calendar day's
+indices (the record's row, placed at the day's start) and day of the year (on the decay's
+storm days, `orbit_env.decay.chunked.STORM_AP`, NRLMSIS's storm-time mode through the day's
+eight 3-hour slots, as the decay takes them), its logarithm interpolated linearly in time, and
+the averaged rates of `orbit_env.decay.averaged` integrated by scipy's DOP853 to re-entry. Slow (about
 25 ms a profile), so it is a yardstick for `orbit_env.decay.chunked.propagate`
 (docs/validation-modern/solar-activity.md), not a path users take for speed.
 """
@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
-from orbit_env.decay.solar import day_of_year
+from orbit_env.decay.solar import calendar_day, day_of_year
 from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
@@ -70,13 +70,16 @@ def _solve_reference(
 ) -> Any:
     """The ``solve_ivp`` solution behind `integrate_reference` and `reference_path`."""
     profiles: dict[int, FloatArray] = {}
+    # The profiles sit at the starts of calendar days (the record's rows, as the decay reads them), from the one
+    # that holds the start.
+    origin_days = float(calendar_day(model.start_days))
 
     def log_profile(index: int) -> FloatArray:
         if index not in profiles:
-            t_days = index * profile_step_days
-            f107, f107a, ap = (float(x) for x in model.activity.indices(model.start_days + t_days))
-            doy = float(day_of_year(model.start_days + t_days)) if model.follow_season else None
-            storm = model.storm_history(model.start_days + t_days)
+            day = origin_days + index * profile_step_days
+            f107, f107a, ap = (float(x) for x in model.activity.indices(day))
+            doy = float(day_of_year(day)) if model.follow_season else None
+            storm = model.storm_history(day)
             if storm is None or np.isnan(storm[0, 0]):
                 rho = mean_density_kg_m3(
                     ALTITUDE_GRID_M,
@@ -106,7 +109,7 @@ def _solve_reference(
 
     def rhs(t_s: float, state: FloatArray) -> list[float]:
         p, e = state[0], max(state[1], 0.0)
-        x = t_s / SECONDS_PER_DAY / profile_step_days
+        x = (t_s / SECONDS_PER_DAY + model.start_days - origin_days) / profile_step_days
         i = math.floor(x)
         w = x - i
         log_rho = (1.0 - w) * log_profile(i) + w * log_profile(i + 1)

@@ -104,6 +104,15 @@ def day_of_year(days: ArrayLike) -> FloatArray:
     return (whole - year_start).astype(np.float64) + 1.0 + (d - np.floor(d))
 
 
+def calendar_day(unix_days: ArrayLike) -> FloatArray:
+    """The start of the calendar (UT) day that holds each of ``unix_days``: the day whose record row it reads.
+
+    The dated decay samples the record there (`orbit_env.decay.chunked.SolarDecayModel.chunk_samples`):
+    a record's rows are calendar days, and its indices between two rows are no day's.
+    """
+    return np.floor(np.asarray(unix_days, dtype=np.float64))
+
+
 @runtime_checkable
 class SolarActivity(Protocol):
     """Anything that gives the indices at given times."""
