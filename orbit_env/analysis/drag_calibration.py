@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,6 +37,7 @@ from numpy.typing import NDArray
 from orbit_env import cache
 from orbit_env.analysis.uncertainty import ONE_SET_DRAG_SIGMA
 from orbit_env.constants import EARTH_RADIUS_M, MU_EARTH_M3_S2
+from orbit_env.decay.solar import calendar_day
 from orbit_env.physics.orbit import corotation_drag_factor
 from orbit_env.workers import in_two_processes
 
@@ -118,9 +120,29 @@ class DragCalibration:
 def air_drag_rate(
     scenario: Any, semi_major_axis_m: float, eccentricity: float, inclination_deg: float, epoch_days: float | None
 ) -> float:
-    """<rho_air v^3> F_rot over the flown orbit at the epoch [kg/s^3], the scenario's scale included."""
+    """<rho_air v^3> F_rot over the flown orbit at the epoch [kg/s^3], the scenario's scale included.
+
+    The air is the mean over the `FIT_SPAN_DAYS` before the epoch (an orbit determination's span).
+    """
+    return _air_rate(
+        scenario,
+        semi_major_axis_m,
+        eccentricity,
+        inclination_deg,
+        lambda height_m: scenario.air.density_near_kg_m3(height_m, inclination_deg, epoch_days, FIT_SPAN_DAYS),
+    )
+
+
+def _air_rate(
+    scenario: Any,
+    semi_major_axis_m: float,
+    eccentricity: float,
+    inclination_deg: float,
+    density_kg_m3: Callable[[FloatArray], Any],
+) -> float:
+    """<rho v^3> F_rot over the flown orbit [kg/s^3] of the density at heights ``density_kg_m3``, the scale included."""
     radius, speed3, weight = _orbit(semi_major_axis_m, eccentricity)
-    rho = scenario.air.density_near_kg_m3(radius - EARTH_RADIUS_M, inclination_deg, epoch_days, FIT_SPAN_DAYS)
+    rho = density_kg_m3(radius - EARTH_RADIUS_M)
     rate = float(np.sum(rho * speed3 * weight)) * scenario.density_scale
     if scenario.corotating:
         q = semi_major_axis_m * (1.0 - eccentricity)
@@ -213,6 +235,17 @@ def _rates_description(
     return f"history rates {air} {cache.describe(tuple(float(v) for v in settings))} path={path}"
 
 
+def _days_air_description(model: Any, days: FloatArray) -> str:
+    """What `SolarDecayModel.density_on_day_kg_m3` reads on ``days``: the settings and a digest of the indices."""
+    from orbit_env.decay.solar import day_of_year
+
+    storm = model.storm_history(days)
+    read = [*model.activity.indices(days), day_of_year(days), np.array([] if storm is None else storm.ravel())]
+    digest = hashlib.sha256(np.concatenate([np.asarray(x, dtype=np.float64).ravel() for x in read]).tobytes())
+    settings = (model.version, model.ascending_node_local_time_h, model.follow_season, model.storm_ap)
+    return f"days' air {settings!r} days={digest.hexdigest()}"
+
+
 class NoHistoryToFit(ValueError):
     """A history with fewer than two sets a day apart within `HISTORY_SPAN_DAYS` of its latest: nothing to fit.
 
@@ -225,7 +258,8 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
 
     Each set's mean semi-major axis is a measurement; the model's decay from the first,
     da/dt = -(a^2 / mu) c <rho_air v^3> F_rot, is integrated day by day in the air of each
-    day along the observed orbit (the semi-major axes interpolated between the sets) and c
+    day along the observed orbit (the semi-major axes interpolated between the sets; a dated
+    air's each calendar day as the decay reads it, `SolarDecayModel.density_on_day_kg_m3`) and c
     is the least-squares fit of the measured drops to c times the integral. Sets older than
     `HISTORY_SPAN_DAYS` before the latest are left out, and sets of the same epoch count once.
 
@@ -255,19 +289,30 @@ def fit_history(history: list[Any], scenario: Any) -> DragFit:
     middle = 0.5 * (grid[1:] + grid[:-1])
     a_path = np.interp(middle, t, a_m)
 
+    # Each step in the air the decay flies on its day (a dated air: the calendar day's row, storm days in
+    # NRLMSIS's storm-time mode); an undated air has one air.
+    model = scenario.solar_model(inclination) if scenario.time_varying else None
+    step_days = calendar_day(middle)
+
+    def step_rate(a: float, day: float) -> float:
+        if model is None:
+            return air_drag_rate(scenario, a, e, inclination, day)
+        return _air_rate(scenario, a, e, inclination, lambda height_m: model.density_on_day_kg_m3(day, height_m))
+
     def rates(days: slice) -> FloatArray:
         """da/dt per unit c on the steps ``days`` (each step's on its own: a forked child may take half)."""
         return np.array(
-            [
-                a * a / MU_EARTH_M3_S2 * air_drag_rate(scenario, a, e, inclination, day)
-                for a, day in zip(a_path[days], middle[days], strict=True)
-            ],
+            [a * a / MU_EARTH_M3_S2 * step_rate(a, day) for a, day in zip(a_path[days], step_days[days], strict=True)],
             dtype=np.float64,
         )
 
     # The steps' air is most of a fit's cost: kept on disk, so that the same history (another command on
     # the same file, a batch run again) is fitted without NRLMSIS. The key holds all that the rates read.
-    air = scenario.air.near_description(middle, FIT_SPAN_DAYS)
+    air = (
+        scenario.air.near_description(middle, FIT_SPAN_DAYS)
+        if model is None
+        else _days_air_description(model, step_days)
+    )
     key = None if air is None else _rates_description(air, scenario, a_path, middle, e, inclination)
     stored = cache.load("fit", key)
     if stored is not None:

@@ -332,6 +332,46 @@ class SolarDecayModel:
         history[~storm] = np.nan
         return history
 
+    def density_on_day_kg_m3(self, day_days: float, heights_m: ArrayLike) -> FloatArray:
+        """NRLMSIS averaged over the orbit at the indices of ``day_days`` (Unix) [kg/m^3], at ``heights_m``.
+
+        The air the decay reads on that day, without its caches' rounding: a calendar day's start
+        (`calendar_day`) reads the record's row; its day of the year (or the year's nodes without
+        ``follow_season``); on a storm day (`storm_history`) NRLMSIS's storm-time mode through its
+        eight 3-hour slots. The daily reference (`orbit_env.decay.reference_path`) and a history's drag
+        fit (`orbit_env.analysis.drag_calibration.fit_history`) read it.
+        """
+        from orbit_env.physics.atmosphere.msis import ap_histories, mean_density_kg_m3, mean_density_over_days_kg_m3
+
+        f107, f107a, ap = (float(x) for x in self.activity.indices(day_days))
+        doy = float(day_of_year(day_days)) if self.follow_season else None
+        storm = self.storm_history(day_days)
+        if storm is None or np.isnan(storm[0, 0]):
+            rho = mean_density_kg_m3(
+                heights_m,
+                f107,
+                f107a,
+                ap,
+                self.inclination_deg,
+                doy,
+                self.ascending_node_local_time_h,
+                version=self.version,
+            )
+        else:
+            days = np.array([doy]) if doy is not None else season_days()
+            rho = mean_density_over_days_kg_m3(
+                heights_m,
+                f107,
+                f107a,
+                ap,
+                days,
+                self.inclination_deg,
+                self.ascending_node_local_time_h,
+                version=self.version,
+                ap_history=np.repeat(ap_histories([ap], storm), days.size, axis=0),
+            )
+        return np.asarray(rho, dtype=np.float64)
+
     def prefetch(self, daily: DailyIndices, t_days: float) -> None:
         """Make sure the air table holds ``daily``; if not, it also computes the `PREFETCH_DAYS` from ``t_days``.
 

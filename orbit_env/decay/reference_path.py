@@ -19,15 +19,11 @@ from numpy.typing import NDArray
 
 from orbit_env.constants import DAYS_PER_YEAR, G0_M_S2, REENTRY_ALTITUDE_M, SECONDS_PER_DAY
 from orbit_env.decay.averaged import DecayModel
-from orbit_env.decay.solar import calendar_day, day_of_year
+from orbit_env.decay.solar import calendar_day
 from orbit_env.physics.atmosphere import FunctionAtmosphere
 from orbit_env.physics.atmosphere.msis import (
     ALTITUDE_GRID_M,
-    ap_histories,
     interpolate_log_density,
-    mean_density_kg_m3,
-    mean_density_over_days_kg_m3,
-    season_days,
 )
 from orbit_env.physics.orbit import elements_from_heights, heights_from_elements, period_s
 
@@ -76,35 +72,9 @@ def _solve_reference(
 
     def log_profile(index: int) -> FloatArray:
         if index not in profiles:
-            day = origin_days + index * profile_step_days
-            f107, f107a, ap = (float(x) for x in model.activity.indices(day))
-            doy = float(day_of_year(day)) if model.follow_season else None
-            storm = model.storm_history(day)
-            if storm is None or np.isnan(storm[0, 0]):
-                rho = mean_density_kg_m3(
-                    ALTITUDE_GRID_M,
-                    f107,
-                    f107a,
-                    ap,
-                    model.inclination_deg,
-                    doy,
-                    model.ascending_node_local_time_h,
-                    version=model.version,
-                )
-            else:  # a storm day (`orbit_env.decay.chunked.STORM_AP`): NRLMSIS's storm-time mode, as the decay
-                days = np.array([doy]) if doy is not None else season_days()
-                rho = mean_density_over_days_kg_m3(
-                    ALTITUDE_GRID_M,
-                    f107,
-                    f107a,
-                    ap,
-                    days,
-                    model.inclination_deg,
-                    model.ascending_node_local_time_h,
-                    version=model.version,
-                    ap_history=np.repeat(ap_histories([ap], storm), days.size, axis=0),
-                )
-            profiles[index] = np.log(rho)
+            profiles[index] = np.log(
+                model.density_on_day_kg_m3(origin_days + index * profile_step_days, ALTITUDE_GRID_M)
+            )
         return profiles[index]
 
     def rhs(t_s: float, state: FloatArray) -> list[float]:

@@ -155,10 +155,12 @@ def test_a_history_fits_air_is_kept_on_disk_under_a_key_of_all_it_reads(monkeypa
     from orbit_env.decay.solar_record import load_record
 
     monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", str(tmp_path))
+    from orbit_env.decay.chunked import SolarDecayModel
+
     monkeypatch.setattr(workers, "can_fork", lambda: False)  # every step's air in this process, counted
     calls = []
-    original = MsisAir.density_near_kg_m3
-    monkeypatch.setattr(MsisAir, "density_near_kg_m3", lambda *a, **k: calls.append(1) or original(*a, **k))
+    original = SolarDecayModel.density_on_day_kg_m3
+    monkeypatch.setattr(SolarDecayModel, "density_on_day_kg_m3", lambda *a, **k: calls.append(1) or original(*a, **k))
     sets = read_tle(next(DATA.glob("41619_*.tle")))[-4:]
     scenario = Scenario(MsisAir(load_record(), sets[-1].epoch_days), rotating_atmosphere=True)
     first = fit_history(sets, scenario)
@@ -172,6 +174,39 @@ def test_a_history_fits_air_is_kept_on_disk_under_a_key_of_all_it_reads(monkeypa
     assert fit_history(sets, Scenario(quiet, rotating_atmosphere=True)) != first and len(calls) == 3 * steps
     fit_history(sets[1:], scenario)
     assert len(calls) > 3 * steps and len(list(tmp_path.glob("v-*/fit-*.npz"))) == 4
+
+
+def test_a_history_fit_reads_each_days_own_air_as_the_decay_does(monkeypatch):
+    # Each daily step of the fit is flown in its calendar day's air, the row the decay reads on that day
+    # (until 2026-12-07 the mean of the 5 days before the step, the one-set calibration's window: the air lagged
+    # by two days). So a Sun changed on the days before the first set's does not move the fit, one changed on
+    # a day between the sets does. BEESAT-4's last four sets; the record's indices, with no 3-hourly ap.
+    from orbit_env.analysis.elements import read_tle
+    from orbit_env.decay.solar_record import load_record
+
+    monkeypatch.setenv("ORBIT_ENV_CACHE_DIR", "off")
+    record = load_record()
+    sets = read_tle(next(DATA.glob("41619_*.tle")))[-4:]
+    first_day = math.floor(sets[0].epoch_days)
+
+    class Changed:
+        """The record's indices, F10.7 x 1.5 on the days ``low`` to ``high`` (calendar days)."""
+
+        def __init__(self, low: float, high: float) -> None:
+            self.low, self.high = low, high
+
+        def indices(self, days):
+            f107, f107a, ap = record.indices(days)
+            day = np.floor(days)
+            return np.where((day >= self.low) & (day <= self.high), 1.5 * f107, f107), f107a, ap
+
+    def fit(activity):
+        return fit_history(sets, Scenario(MsisAir(activity, sets[-1].epoch_days), rotating_atmosphere=True))
+
+    plain = fit(Changed(0.0, -1.0))
+    assert fit(Changed(first_day - 4.0, first_day - 1.0)) == plain
+    inside = fit(Changed(first_day + 10.0, first_day + 13.0))
+    assert inside.drag_parameter_m2_kg < 0.99 * plain.drag_parameter_m2_kg  # denser days: less drag to fit
 
 
 def test_ndot_and_bstar_agree_when_the_set_is_self_consistent():
