@@ -327,7 +327,8 @@ def test_a_batch_of_element_sets_starts_each_object_at_its_own_epoch_in_the_real
         # The same drag parameter (the same calibration or fit, in the same air at the same dates).
         assert float(row["drag_parameter_m2_kg"]) == pytest.approx(single["drag_parameter_m2_kg"], rel=1e-5)
         # The same decay but for the batch's inclination groups (INCLINATION_STEP_DEG; measured 0.06-0.08% on
-        # two 2013 objects): within 0.5%.
+        # two 2013 objects) and for where its steps fall (the objects of all epochs share one run, each joining it
+        # at its own: within 0.26% on twelve orbits, docs/how-to/catalogue.md): within 0.5%.
         assert float(row["days"]) == pytest.approx(single["days"], rel=5e-3)
         assert row["epoch"] == iso_datetime(latest.epoch_days)
         assert row["reentry_date"] == iso_datetime(latest.epoch_days + float(row["days"]))
@@ -371,10 +372,10 @@ def test_a_history_with_no_set_near_its_latest_falls_back_on_the_latest_set_and_
 @pytest.mark.slow
 def test_real_reentries_from_element_sets_meet_the_goals():
     # benchmarks/validate_element_sets.py over the 32 objects (72 cases, 3-13 minutes on 2 cores, as warm as
-    # its disk cache): measured on 2026-12-07 one set median |error| 13.6%, history 11.3% with 93.8% of cases
-    # within +-25%, band coverage 91.5% and 96.9%. Held to issue 27's goals where they were met (one set median
-    # <= 20%, history 90% within +-25%, the 90% band holding >= 85%) and, for the history's median (goal 10%,
-    # not met), to 12%.
+    # its disk cache): measured on 2026-12-07 one set median |error| 14.2%, history 7.8% with 93.8% of cases
+    # within +-25%, band coverage 90.1% and 93.8%. Held to issue 27's goals: one set median <= 20%, history
+    # median <= 10% and 90% within +-25%, the 90% band holding >= 85% (the history's median was held to 12%
+    # while it missed its goal: 11.3% before its fit flew each day in that day's air).
     import benchmark_scripts
 
     script = benchmark_scripts.load("validate_element_sets")
@@ -384,6 +385,6 @@ def test_real_reentries_from_element_sets_meet_the_goals():
     one, history = summary["one set"]["all"], summary["history"]["all"]
     assert one["median_abs_error"] <= 0.20
     assert one["band_coverage"] >= 0.85
-    assert history["median_abs_error"] <= 0.12
+    assert history["median_abs_error"] <= 0.10
     assert history["within_25"] >= 0.90
     assert history["band_coverage"] >= 0.85
