@@ -12,6 +12,8 @@ on the same family (`check_disposal_rule` with these lifetimes). A dated catalog
 time-stepped path) spread over more groups also takes one family, that of the most
 common group, through its chunks, each row's inclination a density multiplier in every
 chunk (`orbit_env.decay.chunked.propagate`), and the rule's search on those lifetimes.
+Rows of different dates (a batch of element sets, each from its own epoch) share one
+time-stepped run from the first, each joining it at its own date (``start_days``).
 The paper's and the exponential law in still air do not depend on the inclination: one
 group.
 """
