@@ -99,13 +99,6 @@ class Air(ABC):
         """
         return np.asarray(self.profile(inclination_deg).density_kg_m3(altitude_m), dtype=np.float64)
 
-    def near_description(self, epochs_days: NDArray[np.float64], span_days: int) -> str | None:
-        """What `density_near_kg_m3` reads on each of ``epochs_days``, as a disk-cache description (`orbit_env.cache`).
-
-        None (the default): not worth a cache entry, as a fixed profile is cached already.
-        """
-        return None
-
     def in_sphere_heights(self, reference: str, inclination_deg: float) -> Air:
         """The same air as a law in heights above the 6371 km sphere, for heights quoted above ``reference``."""
         return self

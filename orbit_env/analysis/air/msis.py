@@ -205,8 +205,7 @@ class MsisAir(Air):
     def _days_read(self, epochs_days: Any, span_days: int) -> Any:
         """F10.7, its 81-day mean, Ap and the day of the year of the ``span_days`` days up to each epoch.
 
-        What `density_near_kg_m3` hands NRLMSIS, and so what `near_description` digests: one place for both.
-        Shape (4, *epochs' shape, span_days).
+        What `density_near_kg_m3` hands NRLMSIS. Shape (4, *epochs' shape, span_days).
         """
         import numpy as np
 
@@ -214,21 +213,6 @@ class MsisAir(Air):
 
         days = np.asarray(epochs_days, dtype=np.float64)[..., None] - np.arange(span_days)[::-1]
         return np.stack([*self.solar.indices(days), day_of_year(days)])
-
-    def near_description(self, epochs_days: Any, span_days: int) -> str | None:
-        """Dated: the version, the node's local time and a digest of the indices and days of the year NRLMSIS reads.
-
-        The indices themselves, not the activity's name: an imported record describes itself by its numbers.
-        """
-        if not self.dated:
-            return None
-        import hashlib
-
-        import numpy as np
-
-        read = self._days_read(epochs_days, span_days)
-        digest = hashlib.sha256(np.ascontiguousarray(read, dtype=np.float64).tobytes()).hexdigest()
-        return f"MsisAir dated version={self.version!r} node={self.ascending_node_local_time_h!r} days={digest}"
 
     def mean_density_over_inclinations_kg_m3(self, altitude_m: Any, inclinations_deg: Any, **nodes: Any) -> Any:
         """`orbit_env.physics.atmosphere.msis.mean_density_over_inclinations_kg_m3` of constant activity."""
