@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from orbit_env.analysis.lifetime import Satellite, lifetime
-from orbit_env.analysis.shapes import ACCOMMODATION, Shape, drag_at_start, flown_nose_first, sphere
+from orbit_env.analysis.shapes import ACCOMMODATION, Shape, cylinder, drag_at_start, flown_nose_first, sphere
 from orbit_env.analysis.uncertainty import DENSITY_MODEL_SIGMA, DRAG_COEFFICIENT_SIGMA
 from orbit_env.constants import DAYS_PER_YEAR
 from orbit_env.decay.solar import SolarActivity, unix_days
@@ -79,19 +79,13 @@ class Case:
     source: str = ""
 
 
-def tumbling_cylinder(diameter_m: float, length_m: float) -> Shape:
-    """A closed cylinder tumbling at random: the sphere of the same surface (same orientation-averaged drag)."""
-    surface_m2 = math.pi * diameter_m * length_m + math.pi * diameter_m**2 / 2.0
-    return sphere(math.sqrt(surface_m2 / math.pi))
-
-
 def shape_of(row: dict[str, str]) -> Shape:
     """The shape of a row of the cases' CSV: ``sphere``, ``tumbling cylinder`` or ``nose-first``."""
     kind = row["shape"]
     if kind == "sphere":
         return sphere(float(row["diameter_m"]))
     if kind == "tumbling cylinder":
-        return tumbling_cylinder(float(row["diameter_m"]), float(row["length_m"]))
+        return cylinder(float(row["diameter_m"]), float(row["length_m"]))
     if kind == "nose-first":
         return flown_nose_first(float(row["front_m2"]), float(row["parallel_m2"]))
     raise ValueError(f"{CASES_CSV.name}: unknown shape {kind!r} for {row['name']}")

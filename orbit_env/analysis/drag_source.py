@@ -61,8 +61,12 @@ class SatelliteInputs:
         area_m2: Reference area.
         mass_per_area_kg_m2: Transverse load G/F (instead of mass and area).
         drag_coefficient: c_x.
-        shape: ``sphere``: the free-molecular C_D of this shape at the start (needs the mass).
-        diameter_m: The sphere's diameter.
+        shape: One of `orbit_env.analysis.shapes.SHAPES`: the free-molecular C_D of this shape at the
+            start (needs the mass); a box, a cylinder and a CubeSat tumbling at random.
+        diameter_m: The sphere's or the cylinder's diameter.
+        length_m: The cylinder's length.
+        size_m: The box's three edges.
+        form_factor: The CubeSat's (``"3U"``, `orbit_env.analysis.shapes.CUBESAT_FORM_FACTORS_M`).
         drag_from: What of one element set gives the drag parameter (`DRAG_FROM_CHOICES`).
     """
 
@@ -72,6 +76,9 @@ class SatelliteInputs:
     drag_coefficient: float | None = None
     shape: str | None = None
     diameter_m: float | None = None
+    length_m: float | None = None
+    size_m: tuple[float, float, float] | None = None
+    form_factor: str | None = None
     drag_from: str | None = None
 
     @property
@@ -129,8 +136,6 @@ def drag_source(
     Raises:
         ValueError: inputs that do not go together, or an element set without decay.
     """
-    if inputs.shape is None and inputs.diameter_m is not None:
-        raise ValueError("--diameter-m goes with --shape sphere")
     if inputs.given and inputs.drag_from is not None:
         flags = {"--mass": inputs.mass_kg, "--area": inputs.area_m2, "--mass-per-area": inputs.mass_per_area_kg_m2}
         flags.update({"--cx": inputs.drag_coefficient, "--shape": inputs.shape})
@@ -140,21 +145,18 @@ def drag_source(
             "its own drag instead: drop one of them"
         )
     cx = PAPER_DRAG_COEFFICIENT if inputs.drag_coefficient is None else inputs.drag_coefficient
-    if inputs.shape is not None:
-        if inputs.diameter_m is None:
-            raise ValueError("--shape sphere needs --diameter-m")
+    body = shape_of(inputs)
+    if body is not None:
         if inputs.mass_kg is None:
             raise ValueError("--shape needs --mass (the drag parameter is C_D A / m)")
         if inputs.area_m2 is not None or inputs.mass_per_area_kg_m2 is not None:
             raise ValueError("--shape sets the area; do not give --area or --mass-per-area")
-        from orbit_env.analysis.shapes import sphere
-
-        body = sphere(inputs.diameter_m)
-        report: dict[str, Any] = {}
+        report: dict[str, Any] = {"shape": body.description, "reference_area_m2": body.reference_area_m2}
         if inputs.drag_coefficient is None and sphere_heights_km is not None:
-            cx, report = shape_drag_coefficient(
+            cx, gas = shape_drag_coefficient(
                 body, sphere_heights_km, inclination_deg, scenario, ascending_node_local_time_h
             )
+            report.update(gas)
         return DragSource(make_satellite(cx, inputs.mass_kg, body.reference_area_m2), SOURCE_SHAPE, report)
     no_fit = None
     if not inputs.given and history is not None:
@@ -178,6 +180,33 @@ def drag_source(
         return DragSource(_drag_satellite(c, f"the element set ({READ_AS[source]})"), source, report)
     satellite = make_satellite(cx, inputs.mass_kg, inputs.area_m2, inputs.mass_per_area_kg_m2)
     return DragSource(satellite, SOURCE_SATELLITE if inputs.given else SOURCE_DEFAULT)
+
+
+def shape_of(inputs: SatelliteInputs) -> Any:
+    """The `orbit_env.analysis.shapes.Shape` the inputs describe, or None without ``shape``.
+
+    Raises:
+        ValueError: a shape without its dimensions, or a dimension that is not its shape's (named by flag).
+    """
+    from orbit_env.analysis.shapes import SHAPE_DIMENSIONS, SHAPES, make_shape
+
+    def flag(name: str) -> str:
+        return "--" + name.replace("_", "-")
+
+    dimensions = {name: getattr(inputs, name) for name in ("diameter_m", "length_m", "size_m", "form_factor")}
+    needs = SHAPE_DIMENSIONS.get(inputs.shape or "", ())
+    for name, value in dimensions.items():
+        if value is not None and name not in needs:
+            owners = " or ".join(shape for shape, takes in SHAPE_DIMENSIONS.items() if name in takes)
+            raise ValueError(f"{flag(name)} goes with --shape {owners}")
+    if inputs.shape is None:
+        return None
+    if inputs.shape not in SHAPES:
+        raise ValueError(f"unknown shape {inputs.shape!r}; known: {', '.join(SHAPES)}")
+    missing = [flag(name) for name in needs if dimensions[name] is None]
+    if missing:
+        raise ValueError(f"--shape {inputs.shape} needs {' and '.join(missing)}")
+    return make_shape(inputs.shape, **dimensions)
 
 
 def _drag_satellite(c: float, where: str) -> Satellite:

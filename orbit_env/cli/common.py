@@ -176,6 +176,8 @@ FLAGS: dict[str, tuple[str, float, str | None]] = {
     "semi_major_axis_km": ("semi_major_axis_km", 1.0, None),
     "eccentricity": ("eccentricity", 1.0, None),
     "diameter_m": ("diameter_m", 1.0, None),
+    "length_m": ("length_m", 1.0, None),
+    "size_m": ("size_m", 1.0, None),
     "samples": ("samples", 1.0, None),
     "seed": ("seed", 1.0, None),
     "rule_years": ("rule", 1.0, None),
@@ -186,8 +188,11 @@ FLAGS: dict[str, tuple[str, float, str | None]] = {
 
 def in_flags(error: InputError, args: argparse.Namespace) -> str:
     """The error in the command line's words: the flag, the value as typed, the flag's unit."""
-    if error.name == "mass_kg / area_m2" and error.index is None and given(args, "mass") and given(args, "area"):
-        return error.message("--mass / --area")  # G/F of the two flags, in their units
+    if error.name == "mass_kg / area_m2" and error.index is None and given(args, "mass"):
+        if given(args, "area"):
+            return error.message("--mass / --area")  # G/F of the two flags, in their units
+        if getattr(args, "shape", None) is not None:
+            return error.message(f"--mass / the {args.shape}'s area")
     if error.name not in FLAGS or error.index is not None or not hasattr(args, FLAGS[error.name][0]):
         return str(error)  # not a flag's value (a file's cell, an element of a table)
     dest, factor, unit = FLAGS[error.name]

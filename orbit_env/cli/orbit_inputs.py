@@ -98,13 +98,27 @@ def add_orbit_options(parser: argparse.ArgumentParser) -> None:
 
 
 def add_shape_options(group: Any) -> None:
-    """``--shape`` and ``--diameter-m`` in the satellite group."""
+    """``--shape`` and its dimensions in the satellite group."""
+    from orbit_env.analysis.shapes import CUBESAT_FORM_FACTORS_M, SHAPES
+
     group.add_argument(
         "--shape",
-        choices=("sphere",),
-        help="free-molecular C_D of this shape at the orbit (needs --mass; with --cx, the shape gives the area only)",
+        choices=SHAPES,
+        help="free-molecular C_D of this shape at the orbit (needs --mass; with --cx, the shape gives the area "
+        "only); a box, a cylinder or a CubeSat tumbles at random (its mean cross-section, a quarter of its surface)",
     )
-    group.add_argument("--diameter-m", type=number, metavar="M", help="with --shape sphere: its diameter [m]")
+    group.add_argument(
+        "--diameter-m", type=number, metavar="M", help="with --shape sphere or cylinder: its diameter [m]"
+    )
+    group.add_argument("--length-m", type=number, metavar="M", help="with --shape cylinder: its length [m]")
+    group.add_argument(
+        "--size-m", type=number, nargs=3, metavar=("X", "Y", "Z"), help="with --shape box: its three edges [m]"
+    )
+    group.add_argument(
+        "--form-factor",
+        choices=tuple(CUBESAT_FORM_FACTORS_M),
+        help="with --shape cubesat: its form factor (the CubeSat Design Specification's envelope, panels stowed)",
+    )
 
 
 def prepare(args: argparse.Namespace) -> OrbitInput:
@@ -228,6 +242,9 @@ def satellite_inputs(args: argparse.Namespace) -> SatelliteInputs:
         drag_coefficient=getattr(args, "cx", None),
         shape=getattr(args, "shape", None),
         diameter_m=getattr(args, "diameter_m", None),
+        length_m=getattr(args, "length_m", None),
+        size_m=None if getattr(args, "size_m", None) is None else tuple(args.size_m),
+        form_factor=getattr(args, "form_factor", None),
         drag_from=getattr(args, "drag_from", None),
     )
 
@@ -305,6 +322,8 @@ def satellite_line(drag: DragSource) -> str:
         f"satellite          c_x {satellite.drag_coefficient:.4g}, {satellite.mass_kg:g} kg, "
         f"{satellite.area_m2:.4g} m^2 (G/F = {satellite.mass_per_area_kg_m2:.4g} kg/m^2, c_x A/m = {c:.4g} m^2/kg)"
     )
+    if "shape" in report:
+        text += f"; {report['shape']}"
     if "speed_ratio" in report:
         text += (
             f"; free-molecular c_x (Sentman) at S = {report['speed_ratio']:.2f}, "

@@ -1,0 +1,103 @@
+"""Shapes as an analyst gives them: a sphere, and a box, a cylinder or a CubeSat tumbling at random."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from orbit_env.analysis.shapes import CUBESAT_FORM_FACTORS_M, box, cubesat, cylinder, make_shape, sphere
+from orbit_env.cli import main
+from orbit_env.physics.drag import panel_drag_area_m2
+
+
+def test_a_tumbling_body_flies_a_quarter_of_its_surface():
+    # Surfaces by hand: a 0.1 x 0.2 x 0.3 m box 2 (0.02 + 0.06 + 0.03) = 0.22 m^2; Explorer 1's
+    # 2.03 m x 0.152 m cylinder pi 0.152 2.03 + 2 pi 0.076^2 = 1.0057 m^2; a 3U CubeSat's envelope,
+    # 100 x 100 x 340.5 mm, 2 (0.01 + 2 x 0.03405) = 0.1562 m^2.
+    assert box((0.1, 0.2, 0.3)).reference_area_m2 == pytest.approx(0.22 / 4, rel=1e-12)
+    explorer = cylinder(0.152, 2.03)
+    assert explorer.reference_area_m2 == pytest.approx((math.pi * 0.152 * 2.03 + 2 * math.pi * 0.076**2) / 4)
+    assert cubesat("3U").reference_area_m2 == pytest.approx(0.1562 / 4, rel=1e-12)
+    assert all(shape.sphere for shape in (box((0.1, 0.2, 0.3)), explorer, cubesat("3U")))
+    assert cubesat("6U").description == "6U CubeSat (0.2263 x 0.1 x 0.366 m), tumbling"
+    assert make_shape("cylinder", diameter_m=0.152, length_m=2.03) == explorer
+    assert make_shape("sphere", diameter_m=0.3) == sphere(0.3)
+
+
+def test_a_tumbling_box_drags_as_its_faces_averaged_over_all_directions():
+    # The claim behind every tumbling shape, checked on an elongated box (a 3U CubeSat), not only a cube:
+    # the six faces' Sentman drag averaged over random flow directions against the shape's coefficient on
+    # its reference area. The tolerance is four standard errors of the sampled mean.
+    x, y, z = CUBESAT_FORM_FACTORS_M["3U"]
+    rng = np.random.default_rng(11)
+    directions = rng.normal(size=(200_000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    normals = np.vstack([np.eye(3), -np.eye(3)])
+    areas = np.array([y * z, x * z, x * y] * 2)
+    s, wall_to_gas = 7.0, 300.0 / 1000.0
+    drag = panel_drag_area_m2(areas, directions @ normals.T, s, wall_to_gas)
+    shape = cubesat("3U")
+    expected = float(shape.drag_coefficient(np.array(s), np.array(wall_to_gas))) * shape.reference_area_m2
+    assert abs(drag.mean() - expected) <= 4 * drag.std() / math.sqrt(drag.size)
+
+
+@pytest.mark.parametrize(
+    ("sizes", "problem"),
+    [
+        ((0.1, 0.0, 0.3), "size_m"),
+        ((0.1, 0.2), "three edges"),
+        ((999.0, 999.0, 999.0), "the box's area"),
+    ],
+)
+def test_a_box_out_of_any_satellites_range_is_refused(sizes, problem):
+    with pytest.raises(ValueError, match=problem):
+        box(sizes)
+
+
+def test_an_unknown_form_factor_names_the_known_ones():
+    with pytest.raises(ValueError, match=r"unknown CubeSat form factor '5U'; known: 0\.5U, 1U"):
+        cubesat("5U")
+
+
+def lifetime_json(capsys, *flags: str) -> dict:
+    argv = ["lifetime", "--perigee", "400", "--apogee", "420", "--inclination", "51.6", "--mass", "4", *flags]
+    assert main([*argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_the_command_flies_a_cubesat_as_the_box_of_its_envelope(capsys):
+    pytest.importorskip("pymsis")
+    as_cubesat = lifetime_json(capsys, "--shape", "cubesat", "--form-factor", "3U")
+    as_box = lifetime_json(capsys, "--shape", "box", "--size-m", "0.1", "0.1", "0.3405")
+    assert as_cubesat["drag_parameter_source"] == "shape"
+    assert as_cubesat["shape"] == "3U CubeSat (0.1 x 0.1 x 0.3405 m), tumbling"
+    assert as_cubesat["reference_area_m2"] == pytest.approx(0.1562 / 4, rel=1e-12)
+    cd = as_cubesat["drag_coefficient"]
+    assert 2.0 < cd < 2.3  # Sentman's sphere coefficient in low orbit (hypersonic cold-wall limit 2)
+    assert as_cubesat["drag_parameter_m2_kg"] == pytest.approx(cd * 0.1562 / 4 / 4.0, rel=1e-12)
+    assert as_box["days"] == as_cubesat["days"]
+    # --cx keeps the shape's area and replaces its coefficient.
+    fixed = lifetime_json(capsys, "--shape", "cubesat", "--form-factor", "3U", "--cx", "2.2")
+    assert fixed["drag_parameter_m2_kg"] == pytest.approx(2.2 * 0.1562 / 4 / 4.0, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--shape", "box"], "--shape box needs --size-m"),
+        (["--shape", "cylinder", "--diameter-m", "1"], "--shape cylinder needs --length-m"),
+        (["--shape", "cubesat"], "--shape cubesat needs --form-factor"),
+        (["--diameter-m", "1"], "--diameter-m goes with --shape sphere or cylinder"),
+        (["--shape", "sphere", "--diameter-m", "1", "--length-m", "2"], "--length-m goes with --shape cylinder"),
+        (["--form-factor", "3U"], "--form-factor goes with --shape cubesat"),
+        (["--shape", "cubesat", "--form-factor", "3U", "--area", "0.1"], "--shape sets the area"),
+        (["--shape", "box", "--size-m", "0.1", "-1", "0.3"], "--size-m -1 is out of range"),
+    ],
+)
+def test_a_shape_without_its_dimensions_or_with_anothers_is_refused(capsys, flags, message):
+    argv = ["lifetime", "--perigee", "400", "--apogee", "420", "--mass", "4", *flags]
+    assert main(argv) == 2
+    assert capsys.readouterr().err.startswith(f"orbit-env: error: {message}")
