@@ -94,11 +94,11 @@ def read_observations(path: str | Path) -> Observations:
             values, dates outside 1957-2200, times not increasing; the message names the
             file and the line.
     """
-    from orbit_env.analysis.elements import looks_like_tle
+    from orbit_env.analysis.elements import holds_element_sets
 
     table = read_csv(path)
     source = table.source
-    if looks_like_tle(path):
+    if holds_element_sets(path):
         raise ValueError(
             f"{source} holds element sets, not observed orbits (date, perigee_km, apogee_km): an element set "
             "history's drag is fitted by orbit-env lifetime --tle FILE"

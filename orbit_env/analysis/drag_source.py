@@ -337,7 +337,7 @@ def element_set_orbits(
     the decay between its sets; an object with one set has its drag read from it as ``drag_from``
     says (`drag_from_elements`: by default its B* calibrated to ``scenario``'s air, in the sphere's
     heights). With ``satellite_given`` every row flies ``satellite``. A row that cannot be decayed
-    says why in its status, naming the set's line; so does an object with a set that could not be
+    says why in its status, naming the set's line (or record); so does an object with a set that could not be
     read (``bad_sets``, `orbit_env.analysis.elements.BadSet`): the batch goes on without it.
     Each row says where its drag came from (``drag_parameter_source``, as JSON's for one lifetime).
     ``progress``: a bar of the objects whose drag is read or fitted (a history's fit, cold, takes NRLMSIS
@@ -391,15 +391,15 @@ def element_set_orbits(
                 c[i], source[i], _ = drag_from_elements(s, scenario, drag_from or DRAG_FROM_DEFAULT)
                 sigma[i] = ONE_SET_DRAG_SIGMA
         except NoDragInSet as error:  # the satellite of the command line would fly every row: not offered
-            status[i] = f"line {s.line}: {error.value} gives no drag parameter"
+            status[i] = f"{s.where}: {error.value} gives no drag parameter"
         except ValueError as error:
-            status[i] = f"line {s.line}: {error}"
+            status[i] = f"{s.where}: {error}"
     for i in range(n):
         if status[i] == "ok":
             try:
                 UniversalCurves.check_domain(hp[i], ha[i])
             except ValueError:  # its message names metres above the sphere; the row shows km flown
-                status[i] = f"line {latest[i].line}: {_beyond_the_curves(latest[i], offset_m)}"
+                status[i] = f"{latest[i].where}: {_beyond_the_curves(latest[i], offset_m)}"
         if status[i] != "ok" or satellite_given:
             source[i] = SOURCE_SATELLITE if satellite_given else ""
         if status[i] != "ok" and not satellite_given:

@@ -26,7 +26,7 @@ import numpy as np
 
 from orbit_env.analysis.air import MsisAir
 from orbit_env.analysis.drag_source import DragSource, SatelliteInputs, drag_sigma, drag_source
-from orbit_env.analysis.elements import ElementSet, parse_tle_text, read_tle
+from orbit_env.analysis.elements import ElementSet, parse_element_sets, parse_tle_text, read_tle
 from orbit_env.analysis.heights import offset_km
 from orbit_env.analysis.lifetime import LifetimeResult, iso_datetime, lifetime
 from orbit_env.analysis.scenario import Scenario
@@ -182,7 +182,7 @@ def element_set_lifetime(
             (`check_flown`), a scenario as above, or what `drag_source` and `lifetime` refuse.
     """
     if isinstance(sets, str) and "\n" in sets:
-        parsed = parse_tle_text(sets)
+        parsed = parse_element_sets(sets)
     elif isinstance(sets, (str, Path)):
         parsed = read_tle(sets)
     else:

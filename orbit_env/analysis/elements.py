@@ -1,10 +1,12 @@
-"""Element sets: two- and three-line element sets (TLE) and mean elements, read into orbits and drag.
+"""Element sets: two- and three-line element sets (TLE), OMM records and mean elements, read into orbits and drag.
 
-An analyst's orbit is a TLE (from CelesTrak or Space-Track) or a mean semi-major axis
-and eccentricity. This module reads TLEs through the ``sgp4`` package (Brandon Rhodes,
-MIT licence; Vallado et al. 2006, "Revisiting Spacetrack Report #3"), after checking
-each line's layout and checksum itself so that a malformed set is a one-line error
-naming the file's line.
+An analyst's orbit is an element set from CelesTrak or Space-Track, as a TLE or as an
+Orbit Mean-Elements Message (OMM, CCSDS 502.0-B-3: the same SGP4 elements by name, in JSON,
+CSV or XML, the form CelesTrak recommends since catalogue numbers outgrow the TLE's five
+columns), or a mean semi-major axis and eccentricity. This module reads both through the
+``sgp4`` package (Brandon Rhodes, MIT licence; Vallado et al. 2006, "Revisiting Spacetrack
+Report #3"), after checking each line's layout and checksum, or each record's fields,
+itself so that a malformed set is a one-line error naming the file's line or record.
 
 Units: km for heights and the semi-major axis (the user's units), unix days for the
 epoch, m^2/kg for the drag parameter. Heights from elements are above the WGS84
@@ -23,13 +25,15 @@ in which case no drag parameter follows from it (give the satellite instead).
 from __future__ import annotations
 
 import calendar
+import json
 import math
 import re
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from orbit_env.checks import DATE_RANGE, check_number
 from orbit_env.constants import EARTH_EQUATORIAL_RADIUS_M
@@ -68,7 +72,9 @@ class ElementSet:
         line: The file's line number of the set's first line (0: not from a file).
         ndot_rev_day2: The first derivative of the mean motion [rev/day^2], twice line 1's
             ndot / 2 (None: not from a TLE).
-        catalogue_number: The satellite's catalogue number (line 1, columns 3-7; "" if none).
+        catalogue_number: The satellite's catalogue number (line 1, columns 3-7; an OMM's NORAD_CAT_ID;
+            "" if none).
+        record: The set's record in an OMM JSON or XML file, from 1 (0: a TLE's or CSV's, placed by ``line``).
     """
 
     name: str
@@ -80,6 +86,12 @@ class ElementSet:
     line: int = 0
     ndot_rev_day2: float | None = None
     catalogue_number: str = ""
+    record: int = 0
+
+    @property
+    def where(self) -> str:
+        """Where the set is in its file, for messages: ``line 12`` or ``record 3``."""
+        return f"record {self.record}" if self.record else f"line {self.line}"
 
     @property
     def perigee_km(self) -> float:
@@ -229,29 +241,41 @@ def parse_tle(
         satrec = Satrec.twoline2rv(line1, line2, WGS72)
     except ValueError as error:
         raise ValueError(f"{where1}: cannot read the element set ({error})") from None
-    if satrec.error != 0:
-        raise ValueError(
-            f"{where1}: SGP4 refuses the elements (error {satrec.error}: {_SGP4_ERRORS.get(satrec.error)})"
-        )
-    epoch_days = (satrec.jdsatepoch - 2440587.5) + satrec.jdsatepochF
-    (first_day, first_date), _ = DATE_RANGE  # two-digit years reach 2056 at most
-    if epoch_days < first_day:
-        raise ValueError(
-            f"{where1}, columns 19-32: the epoch is {_iso(epoch_days)} (a two-digit year 57-99 is 1957-1999); "
-            f"allowed: from {first_date} (no satellite flew before Sputnik 1)"
-        )
-    # satrec.a is the Brouwer mean semi-major axis in Earth radii (of the WGS72 constants SGP4 uses).
-    a_km = satrec.a * satrec.radiusearthkm
-    return ElementSet(
+    return _from_satrec(
+        satrec,
+        where1,
+        "columns 19-32",
         name=(name or line1[2:7]).strip(),
-        epoch_days=epoch_days,
-        semi_major_axis_km=a_km,
-        eccentricity=satrec.ecco,
-        inclination_deg=math.degrees(satrec.inclo),
-        bstar_per_earth_radius=satrec.bstar,
         line=first_line,
         ndot_rev_day2=2.0 * float(line1[33:43]),
         catalogue_number=line1[2:7].strip(),
+    )
+
+
+def _from_satrec(satrec: Any, where: str, epoch_field: str, **identity: Any) -> ElementSet:
+    """The element set of an initialised ``sgp4`` Satrec (``identity``: `ElementSet`'s other fields).
+
+    Raises:
+        ValueError: SGP4 refuses the elements, or the epoch (``epoch_field`` of ``where``) is before Sputnik 1.
+    """
+    if satrec.error != 0:
+        raise ValueError(f"{where}: SGP4 refuses the elements (error {satrec.error}: {_SGP4_ERRORS.get(satrec.error)})")
+    epoch_days = (satrec.jdsatepoch - 2440587.5) + satrec.jdsatepochF
+    (first_day, first_date), _ = DATE_RANGE  # a TLE's two-digit years reach 2056 at most
+    if epoch_days < first_day:
+        two_digits = " (a two-digit year 57-99 is 1957-1999)" if epoch_field.startswith("columns") else ""
+        raise ValueError(
+            f"{where}, {epoch_field}: the epoch is {_iso(epoch_days)}{two_digits}; "
+            f"allowed: from {first_date} (no satellite flew before Sputnik 1)"
+        )
+    # satrec.a is the Brouwer mean semi-major axis in Earth radii (of the WGS72 constants SGP4 uses).
+    return ElementSet(
+        epoch_days=epoch_days,
+        semi_major_axis_km=satrec.a * satrec.radiusearthkm,
+        eccentricity=satrec.ecco,
+        inclination_deg=math.degrees(satrec.inclo),
+        bstar_per_earth_radius=satrec.bstar,
+        **identity,
     )
 
 
@@ -267,8 +291,8 @@ _SGP4_ERRORS = {
 class BadSet(NamedTuple):
     """An element set that could not be read (`parse_tle_text` with ``bad``): where, whose, and why."""
 
-    line: int  # the file's line of its TLE line 1
-    catalogue_number: str  # as line 1 gives it (columns 3-7)
+    line: int  # the file's line of its TLE line 1 (an OMM's line or record)
+    catalogue_number: str  # as line 1 gives it (columns 3-7), or the OMM's NORAD_CAT_ID
     name: str | None  # its name line, if any
     message: str  # what is wrong, naming the line (without the file's name)
 
@@ -322,17 +346,186 @@ def parse_tle_text(
 
 
 def read_tle(path: str | Path, bad: list[BadSet] | None = None) -> list[ElementSet]:
-    """The element sets of a file (``-``: standard input); see `parse_tle_text` (and its ``bad``).
+    """The element sets of a file (``-``: standard input): TLEs or OMM records (`parse_element_sets`).
 
     Raises:
-        ValueError: a malformed set, naming the line.
+        ValueError: a malformed set, naming the line (or the record).
         OSError: the file cannot be read.
     """
     if str(path) == "-":
         data = sys.stdin.buffer.read() if hasattr(sys.stdin, "buffer") else sys.stdin.read().encode()
-        return parse_tle_text(_lines(_text(data)), "<stdin>", bad)
+        return parse_element_sets(_text(data), "<stdin>", bad)
     with open(path, "rb") as handle:
-        return parse_tle_text(_lines(_text(handle.read())), str(path), bad)
+        return parse_element_sets(_text(handle.read()), str(path), bad)
+
+
+def parse_element_sets(text: str, source: str = "TLE", bad: list[BadSet] | None = None) -> list[ElementSet]:
+    """Every element set of a text: TLEs (`parse_tle_text`) or OMM records in JSON, CSV or XML (`parse_omm_text`).
+
+    The form is told by the text itself (`omm_format`); ``bad`` as `parse_tle_text`'s.
+    """
+    if omm_format(text) is not None:
+        return parse_omm_text(text, source, bad)
+    return parse_tle_text(_lines(text), source, bad)
+
+
+#: The OMM fields an SGP4 element set needs (CCSDS 502.0-B-3's keywords, as CelesTrak and Space-Track name them).
+OMM_FIELDS = (
+    "EPOCH",
+    "MEAN_MOTION",
+    "ECCENTRICITY",
+    "INCLINATION",
+    "RA_OF_ASC_NODE",
+    "ARG_OF_PERICENTER",
+    "MEAN_ANOMALY",
+    "NORAD_CAT_ID",
+    "BSTAR",
+    "MEAN_MOTION_DOT",
+    "MEAN_MOTION_DDOT",
+)
+#: The bounds of an OMM's numbers, those of the same fields of a TLE (`_FIELDS`); the eccentricity's top excluded.
+_OMM_BOUNDS = {
+    "MEAN_MOTION": (0.0, 20.0),
+    "ECCENTRICITY": (0.0, 1.0),
+    "INCLINATION": (0.0, 180.0),
+    "RA_OF_ASC_NODE": (0.0, 360.0),
+    "ARG_OF_PERICENTER": (0.0, 360.0),
+    "MEAN_ANOMALY": (0.0, 360.0),
+}
+
+
+def omm_format(text: str) -> str | None:
+    """``"json"``, ``"xml"`` or ``"csv"`` for an OMM text, else None (a TLE's text, or none's).
+
+    Told by the first characters, or for CSV by a header naming NORAD_CAT_ID and EPOCH.
+    """
+    start = text.lstrip()
+    if start.startswith(("[", "{")):
+        return "json"
+    if start.startswith("<"):
+        return "xml"
+    header = start.split("\n", 1)[0].upper()
+    if "," in header and "NORAD_CAT_ID" in header and "EPOCH" in header:
+        return "csv"
+    return None
+
+
+def parse_omm_text(text: str, source: str = "OMM", bad: list[BadSet] | None = None) -> list[ElementSet]:
+    """Every element set of an OMM text: JSON (an array of records, or one), CSV (a header row), or XML (CCSDS).
+
+    The keywords are CCSDS's (`OMM_FIELDS`, in any case); numbers may be JSON numbers or text,
+    and other fields (SEMIMAJOR_AXIS, DECAY_DATE, ... as Space-Track adds) are ignored. A JSON
+    or XML record is named by its place (``record 3``), a CSV one by its line. With ``bad``, a
+    record that does not read is appended to it and skipped (as `parse_tle_text`'s).
+
+    Raises:
+        ValueError: text that is not JSON, CSV or XML of records, a record without a field or with
+            a field out of its bounds (the message names the record and the field), or no record.
+    """
+    form = omm_format(text)
+    records: list[tuple[int, int, dict[str, Any]]] = []  # (line, record, fields)
+    if form == "json":
+        try:
+            data = json.loads(text)
+        except ValueError as error:
+            raise ValueError(f"{source}: not a JSON text ({error})") from None
+        for k, record in enumerate(data if isinstance(data, list) else [data], start=1):
+            if not isinstance(record, dict):
+                raise ValueError(f"{source}, record {k}: an OMM record is an object of named fields")
+            records.append((0, k, record))
+    elif form == "xml":
+        from xml.etree import ElementTree
+
+        try:
+            root = ElementTree.fromstring(text)
+        except ElementTree.ParseError as error:
+            raise ValueError(f"{source}: not an XML text ({error})") from None
+        segments = [e for e in root.iter() if e.tag.rsplit("}", 1)[-1] == "segment"]
+        for k, segment in enumerate(segments, start=1):
+            leaves = (e for e in segment.iter() if len(e) == 0)
+            records.append((0, k, {e.tag.rsplit("}", 1)[-1]: (e.text or "").strip() for e in leaves}))
+    elif form == "csv":
+        import csv
+
+        reader = csv.DictReader(_lines(text))
+        for row in reader:
+            if any((value or "").strip() for value in row.values() if isinstance(value, str)):
+                records.append((reader.line_num, 0, row))
+    sets: list[ElementSet] = []
+    for line, record, fields in records:
+        where = f"{source}, record {record}" if record else f"{source}, line {line}"
+        named = {str(key).strip().upper(): value for key, value in fields.items() if key is not None}
+        try:
+            sets.append(_omm_set(named, where, line, record))
+        except ValueError as error:
+            if bad is None:
+                raise
+            number = str(named.get("NORAD_CAT_ID", "")).strip()
+            name = str(named.get("OBJECT_NAME", "")).strip() or None
+            bad.append(BadSet(record or line, number, name, str(error).removeprefix(f"{source}, ")))
+    if not sets and not bad:
+        raise ValueError(f"{source}: no element set found")
+    return sets
+
+
+def _omm_set(fields: dict[str, Any], where: str, line: int, record: int) -> ElementSet:
+    """One OMM record's element set (through ``sgp4.omm.initialize``), or a ValueError naming ``where``."""
+    from sgp4.api import WGS72, Satrec
+    from sgp4.omm import initialize
+
+    text = {key: ("" if value is None else str(value).strip()) for key, value in fields.items()}
+    missing = [key for key in OMM_FIELDS if not text.get(key)]
+    if missing:
+        needs = ", ".join(OMM_FIELDS)
+        raise ValueError(f"{where}: the record has no {', '.join(missing)} (an OMM element set needs {needs})")
+    numbers = {}
+    for key in OMM_FIELDS[1:]:
+        try:
+            numbers[key] = value = float(text[key])
+        except ValueError:
+            raise ValueError(f"{where}: {key} reads {text[key]!r}, not a number") from None
+        lowest, highest = _OMM_BOUNDS.get(key, (-math.inf, math.inf))
+        inside = lowest <= value < highest if key == "ECCENTRICITY" else lowest <= value <= highest
+        if not (math.isfinite(value) and inside):
+            bounds = f"{lowest:g} to {highest:g}" if math.isfinite(highest) else "a finite number"
+            excluded = f" ({highest:g} excluded)" if key == "ECCENTRICITY" else ""
+            raise ValueError(f"{where}: {key} is {text[key]}; allowed: {bounds}{excluded}")
+    number = numbers["NORAD_CAT_ID"]
+    if number < 0 or number != int(number):
+        raise ValueError(f"{where}: NORAD_CAT_ID is {text['NORAD_CAT_ID']}; allowed: a whole number from 0")
+    try:
+        epoch = datetime.fromisoformat(text["EPOCH"].removesuffix("Z"))
+    except ValueError:
+        raise ValueError(
+            f"{where}: EPOCH reads {text['EPOCH']!r}, not a UTC date and time (YYYY-MM-DDThh:mm:ss.ffffff)"
+        ) from None
+    if epoch.tzinfo is not None:
+        raise ValueError(f"{where}: EPOCH {text['EPOCH']!r} has a time zone; an OMM's epoch is UTC, without one")
+    # sgp4's own reader of the record. The catalogue number is ours: SGP4 keeps five Alpha-5 characters (at
+    # most 339999) and never uses it; nor does it use the set's designator, class, type and counts (neutral).
+    given = {
+        **text,
+        "EPOCH": epoch.strftime("%Y-%m-%dT%H:%M:%S.%f"),
+        "NORAD_CAT_ID": "0",
+        "OBJECT_ID": "",
+        "CLASSIFICATION_TYPE": "U",
+        "EPHEMERIS_TYPE": "0",
+        "ELEMENT_SET_NO": "0",
+        "REV_AT_EPOCH": "0",
+    }
+    satrec = Satrec()
+    initialize(satrec, given, WGS72)
+    catalogue_number = str(int(number))
+    return _from_satrec(
+        satrec,
+        where,
+        "EPOCH",
+        name=text.get("OBJECT_NAME") or catalogue_number,
+        line=line,
+        record=record,
+        ndot_rev_day2=2.0 * numbers["MEAN_MOTION_DOT"],  # MEAN_MOTION_DOT is the TLE's field: ndot / 2
+        catalogue_number=catalogue_number,
+    )
 
 
 def _lines(text: str) -> list[str]:
@@ -352,9 +545,14 @@ def _text(data: bytes) -> str:
         return data.decode("latin-1")
 
 
-def looks_like_tle(path: str | Path) -> bool:
-    """Whether a file's first non-blank lines are an element set (rather than a CSV's header)."""
-    # A look only: bytes that are not text make no element set, and the CSV reader names the file.
+def holds_element_sets(path: str | Path) -> bool:
+    """Whether a file holds element sets, TLEs or OMM records (rather than a CSV catalogue of orbits).
+
+    A look at its start only: bytes that are not text make no element set, and the CSV reader names the file.
+    """
     with open(path, encoding="utf-8-sig", errors="replace") as handle:
-        lines = [line.strip() for line in handle.readlines()[:6] if line.strip()]  # indented as pasted: as read_tle
+        start = handle.read(4096)
+    if omm_format(start) is not None:
+        return True
+    lines = [line.strip() for line in _lines(start)[:6] if line.strip()]  # indented as pasted: as read_tle
     return any(line.startswith("1 ") and len(line) == TLE_LINE_LENGTH for line in lines[:2])

@@ -526,8 +526,8 @@ def add_parsers(sub: Any) -> None:
     life.add_argument(
         "--batch",
         metavar="FILE",
-        help="lifetimes of every orbit in a CSV file, or of every object in a file of element sets (each object's "
-        "sets its history; see orbit_env.analysis.catalogue)",
+        help="lifetimes of every orbit in a CSV file, or of every object in a file of element sets, TLE or OMM "
+        "(each object's sets its history; see orbit_env.analysis.catalogue)",
     )
     life.add_argument("--out", type=output_file, metavar="CSV", help="with --batch: the results file")
     life.add_argument(

@@ -73,8 +73,9 @@ def add_orbit_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--tle",
         metavar="FILE",
-        help="two- or three-line element set ('-': stdin): epoch, mean elements (the decay starts from the orbit "
-        "flown: J2's offset added), inclination, B*",
+        help="element sets ('-': stdin): two- or three-line sets (TLE) or OMM records (JSON, CSV or XML, as "
+        "CelesTrak and Space-Track give them); several of one object are its history: epoch, mean elements "
+        "(the decay starts from the orbit flown: J2's offset added), inclination, B*",
     )
     group.add_argument(
         "--drag-from",
@@ -171,9 +172,9 @@ def prepare(args: argparse.Namespace) -> OrbitInput:
             raise ValueError("give either --perigee/--apogee or --semi-major-axis-km/--eccentricity, not both")
         elements = mean_elements(mean_a, ecc, 0.0 if args.inclination is None else args.inclination)
     if getattr(args, "batch", None):
-        from orbit_env.analysis.elements import looks_like_tle, read_tle
+        from orbit_env.analysis.elements import holds_element_sets, read_tle
 
-        args.batch_element_sets = looks_like_tle(args.batch)
+        args.batch_element_sets = holds_element_sets(args.batch)
         # Read once (`read_orbits`); a set that does not read is its object's row's status, not the batch's end.
         args.batch_bad_sets = []
         args.batch_sets = read_tle(args.batch, bad=args.batch_bad_sets) if args.batch_element_sets else None
