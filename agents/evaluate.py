@@ -155,6 +155,51 @@ def policy_name(policy: Any) -> str:
     return type(policy).__name__
 
 
+def load_policy(spec: str) -> tuple[str, Any]:
+    """A policy of one's own named ``FILE.py:NAME`` or ``MODULE:NAME``: (its row's name, the policy).
+
+    NAME is an object with Stable-Baselines3's ``predict``, a function ``observations -> actions``,
+    or a class of either made with no arguments (made here). The row is named NAME.
+
+    Raises:
+        ValueError: a spec without its two parts, a file or module that is not there, no NAME in it, a
+            class that takes arguments, or an object that neither predicts nor is called.
+    """
+    import importlib
+    import importlib.util
+    import sys
+
+    where, colon, attribute = spec.rpartition(":")
+    if not colon or not where or not attribute.isidentifier():
+        raise ValueError(f"--policy {spec}: give FILE.py:NAME or MODULE:NAME (NAME a policy in it)")
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise ValueError(f"--policy {spec}: no file {where}")
+        module_spec = importlib.util.spec_from_file_location(f"_orbit_env_policy_{path.stem}", path)
+        assert module_spec is not None and module_spec.loader is not None
+        module = importlib.util.module_from_spec(module_spec)
+        sys.modules[module_spec.name] = module  # (a dataclass in the file looks its module up)
+        module_spec.loader.exec_module(module)
+    else:
+        try:
+            module = importlib.import_module(where)
+        except ModuleNotFoundError as error:
+            raise ValueError(f"--policy {spec}: no module {error.name} (a file: FILE.py:NAME)") from None
+    if not hasattr(module, attribute):
+        raise ValueError(f"--policy {spec}: {where} has no {attribute}")
+    policy = getattr(module, attribute)
+    if isinstance(policy, type):
+        try:
+            policy = policy()
+        except TypeError as error:
+            why = f"the class {attribute} must be made with no arguments ({error})"
+            raise ValueError(f"--policy {spec}: {why}") from None
+    if not hasattr(policy, "predict") and not callable(policy):
+        raise ValueError(f"--policy {spec}: {attribute} has no predict and is not a function observations -> actions")
+    return attribute, policy
+
+
 def _check_predict(policy: Any, name: str, observations: Any) -> None:
     """ValueError unless ``policy.predict`` takes (observations, deterministic=True), as Stable-Baselines3's does."""
     try:

@@ -92,13 +92,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     if args.returns is not None and not args.certify:
         check_output(args.returns, "--returns", [("the model file of --model", args.model), ("--plot", args.plot)])
     if args.certify:
-        names = ("model", "plot", "no_dp", "returns", "name")
+        names = ("model", "plot", "no_dp", "returns", "name", "policy")
         refused = [flag(name) for name in names if given(args, name)]
         if refused:  # the certificate searches plans against the DP: no learned row, no returns to draw
             raise ValueError(f"--certify searches plans against the DP policy: it takes no {' or '.join(refused)}")
         return _certify(args, say)
+    own = _own_policies(args.policy, args.env in SOLAR_ENV_IDS, args.name)
     if args.env in SOLAR_ENV_IDS:
-        return _evaluate_solar(args, say)
+        return _evaluate_solar(args, say, own)
     check_env_id(args.env)
     policies = all_policies(
         args.env,
@@ -110,6 +111,10 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         dp_rollout=args.dp_rollout,
         learned_name=args.name,
     )
+    for name, policy in own.items():
+        if name in policies:
+            raise ValueError(f"--policy: {name} is the name of a row of the evaluation; give the policy another name")
+        policies[name] = policy
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot is not None:
         plot_returns(results, args.env, args.plot)
@@ -121,14 +126,48 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         "paired_difference": paired_difference(results, name=learned),
         "paired_to_dp": paired_difference(results, name=learned, baseline="dp"),
     }
+    own_pairs = _own_pairs(results, own, None)
     if args.json:
         out = {"env": args.env, "episodes": args.episodes, "seed": args.seed, **_yardsticks(args), "policies": table}
         out.update({key: pair for key, pair in paired.items() if pair is not None})
+        if own:
+            out["paired_policies"] = own_pairs
         print(json.dumps(out))
     else:
         found = [pair for pair in paired.values() if pair is not None]
-        print(format_table(args.env, args.episodes, args.seed, table, found))
+        print(format_table(args.env, args.episodes, args.seed, table, [*found, *own_pairs]))
     return 0
+
+
+def _own_policies(specs: list[str] | None, solar: bool, learned_name: str | None) -> dict[str, Any]:
+    """``--policy``'s policies by row name (`orbit_env.agents.evaluate.load_policy`), loaded before any episode.
+
+    A name that another row has (a rule's, the DP's, an algorithm's, ``--name``'s) is refused here, before
+    the DP's solve.
+    """
+    from orbit_env.agents.evaluate import ALGORITHMS, load_policy, policy_order
+
+    if solar:
+        from orbit_env.agents.solar import registered_rules
+
+        taken = {rule.name for rule in registered_rules()} | {"dp", *ALGORITHMS}
+    else:
+        taken = set(policy_order())
+    own: dict[str, Any] = {}
+    for spec in specs or []:
+        name, policy = load_policy(spec)
+        if name in own or name in taken or name == learned_name:
+            raise ValueError(f"--policy {spec}: {name} is the name of another row; give the policy another name")
+        own[name] = policy
+    return own
+
+
+def _own_pairs(results: Any, own: dict[str, Any], best_rule: str | None) -> list[dict[str, Any]]:
+    """Each ``--policy`` row against the best hand-coded rule (``best_rule``; None: found) and the DP, paired."""
+    from orbit_env.agents.evaluate import paired_difference
+
+    pairs = [paired_difference(results, name=name, baseline=base) for name in own for base in (best_rule, "dp")]
+    return [pair for pair in pairs if pair is not None]
 
 
 def _solar_options(args: argparse.Namespace, solar: bool) -> None:
@@ -154,7 +193,7 @@ def _yardsticks(args: argparse.Namespace, *, lookahead: bool = True) -> dict[str
     return {"dp_policy": None if args.no_dp else dp, "model": args.model if args.model is not None else "shipped"}
 
 
-def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
+def _evaluate_solar(args: argparse.Namespace, say: Any, own: dict[str, Any]) -> int:
     """``evaluate --env OrbitRaisingSolar-v0``: the operators' rules and the per-episode optimum on a split."""
     from orbit_env.agents.evaluate import (
         format_table,
@@ -171,6 +210,10 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
     loaded = load_model(args.env, args.model, warn=lambda text: print(f"{PROG}: warning: {text}", file=sys.stderr))
     learned = {} if loaded is None else {args.name or loaded[0]: loaded[1]}
+    for name, policy in own.items():  # flown as the learned agents are, from the observations
+        if name in learned:
+            raise ValueError(f"--policy: {name} is the name of a row of the evaluation; give the policy another name")
+        learned[name] = policy
     evaluation = evaluate_solar(
         args.episodes,
         args.seed,
@@ -194,13 +237,14 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
     # agent against that rule and against the optimum. The JSON keys mean what they mean for every env:
     # paired_difference the learned agent less the best rule, paired_to_dp the learned agent less the DP.
     best_rule = max(evaluation.rules, key=lambda name: results[name].returns.mean())
-    agent = next(iter(learned), None)
+    agent = next((name for name in learned if name not in own), None)
     pairs = {
         "paired_dp": paired_difference(results, name="dp", baseline=best_rule),
         "paired_difference": None if agent is None else paired_difference(results, name=agent, baseline=best_rule),
         "paired_to_dp": None if agent is None else paired_difference(results, name=agent, baseline="dp"),
     }
     paired = {key: pair for key, pair in pairs.items() if pair is not None}
+    own_pairs = _own_pairs(results, own, best_rule)
     if args.json:
         out = {
             "env": args.env,
@@ -213,10 +257,12 @@ def _evaluate_solar(args: argparse.Namespace, say: Any) -> int:
             **{key: value for key, value in report.items() if key != "policies"},
         }
         out.update(paired)
+        if own:
+            out["paired_policies"] = own_pairs
         print(json.dumps(out))
         return 0
     title = f"{args.env} ({args.solar_split} split)"
-    print(format_table(title, args.episodes, args.seed, table, list(paired.values())))
+    print(format_table(title, args.episodes, args.seed, table, [*paired.values(), *own_pairs]))
     width = policy_width(report["policies"])
     for name, row in report["policies"].items():
         print(
@@ -369,6 +415,14 @@ def add_parsers(sub: Any) -> None:
         metavar="ROW",
         help="the learned agent's row (default: its algorithm, ppo, a2c, ...): two models of one algorithm "
         "side by side, each run under its own name",
+    )
+    ev.add_argument(
+        "--policy",
+        action="append",
+        metavar="FILE.py:NAME",
+        help="a policy of your own scored beside the others, its row named NAME (or MODULE:NAME): an object with "
+        "Stable-Baselines3's predict, a class of one made with no arguments, or a function observations -> "
+        "actions (docs/how-to/score-a-policy.md); repeatable",
     )
     ev.add_argument("--no-dp", action="store_true", help="skip the dynamic-programming optimum")
     ev.add_argument(

@@ -199,3 +199,74 @@ def test_a_policy_that_acts_otherwise_on_the_same_observations_is_flagged():
 
     with pytest.warns(UserWarning, match="coin acts otherwise on the same observations"):
         run_episodes(ENV, coin, 40, 1)
+
+
+RULES = '''
+import numpy as np
+
+from orbit_env.agents.policies import HAND_CODED
+
+
+class Greedy:
+    """The package's greedy look-ahead, made with no arguments: it must score as the greedy row."""
+
+    def __init__(self):
+        from orbit_env.agents.evaluate import hand_coded_policies
+
+        self.inner = hand_coded_policies("OrbitRaising-v0")["greedy"]
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return self.inner.predict(observation, deterministic=deterministic)
+
+
+def idle(observations):
+    return np.zeros(len(np.atleast_2d(observations)), dtype=np.int64)
+
+
+class NeedsArguments:
+    def __init__(self, threshold):
+        self.threshold = threshold
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        return np.zeros(len(observation), dtype=np.int64), None
+
+
+NOT_A_POLICY = 3
+never = idle  # a row the evaluation has
+'''
+
+
+def test_a_policy_of_ones_own_is_scored_from_its_file_beside_the_others(capsys, tmp_path):
+    import json
+
+    from orbit_env.cli import main
+
+    rules = tmp_path / "rules.py"
+    rules.write_text(RULES)
+    flags = ["evaluate", "--episodes", "20", "--no-dp", "--json"]
+    assert main([*flags, "--policy", f"{rules}:Greedy", "--policy", f"{rules}:idle"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    policies = result["policies"]
+    assert list(policies)[-2:] == ["Greedy", "idle"]
+    # The same episodes: the greedy rule scores as the package's own row, doing nothing as never burning.
+    assert policies["Greedy"]["mean_return"] == policies["greedy"]["mean_return"]
+    assert policies["idle"]["mean_return"] == policies["never"]["mean_return"]
+    pairs = {(pair["policy"], pair["baseline"]): pair for pair in result["paired_policies"]}
+    assert pairs[("Greedy", "greedy")]["mean"] == 0.0 and pairs[("idle", "greedy")]["mean"] < 0.0
+    assert result["paired_difference"]["policy"] == "ppo"  # the learned agent's pair as before
+    refused = [
+        ([f"{rules}:NeedsArguments"], "the class NeedsArguments must be made with no arguments"),
+        ([f"{rules}:NOT_A_POLICY"], "NOT_A_POLICY has no predict and is not a function"),
+        ([f"{rules}:missing"], f"{rules} has no missing"),
+        ([f"{tmp_path / 'nowhere.py'}:x"], "no file"),
+        (["no_such_module_here:x"], "no module no_such_module_here"),
+        (["rules.py"], "give FILE.py:NAME or MODULE:NAME"),
+        ([f"{rules}:idle", f"{rules}:idle"], "idle is the name of another row"),
+        ([f"{rules}:never"], "never is the name of another row"),
+        ([f"{rules}:Greedy", "numpy:never"], "has no never"),
+    ]
+    for specs, message in refused:
+        assert main([*flags, *(part for spec in specs for part in ("--policy", spec))]) == 2
+        assert message in capsys.readouterr().err, specs
+    assert main(["evaluate", "--certify", "--policy", f"{rules}:idle"]) == 2
+    assert "it takes no --policy" in capsys.readouterr().err
