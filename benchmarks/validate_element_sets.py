@@ -19,10 +19,13 @@ Per object up to 3 sets of the window: the latest (shortest lead), the set whose
 25% of the longest lead in the window (the earlier one on a tie), and the earliest (longest lead);
 duplicates are dropped, so an object with one or two sets in the window gives one or two cases.
 
-Modes, both through the package's command line run in-process
+Modes, all through the package's command line run in-process
 (``orbit_env.cli.main(["lifetime", "--tle", FILE, "--json", ...])``):
 
 * one set: a file holding the chosen set (a name line and its two lines);
+* known shape (``--shapes``): the same file with the satellite as documented in ``shapes.csv`` (its
+  mass and its body, tumbling at random: ``--mass M --shape cubesat --form-factor 1U`` or ``--shape box
+  --size-m X Y Z``), for the objects listed there; the drag is then the satellite's, not the set's;
 * history (``--history``): a file holding the object's sets with epochs from 60 days before the chosen
   set's epoch up to it, the chosen set last; where there are more than 30, 30 evenly spaced in file
   order, always keeping the oldest and the chosen one. A history of one set is not run ("one set
@@ -77,7 +80,9 @@ DAY_ONLY_UNCERTAINTY_DAYS = 0.5
 WITHIN = 0.25
 #: Lead-time buckets [low, high) in days and their labels.
 BUCKETS = ((0.0, 30.0, "<30 d"), (30.0, 180.0, "30-180 d"), (180.0, math.inf, ">180 d"))
-MODES = ("one set", "history")
+MODES = ("one set", "history", "known shape")
+#: The objects whose mass and body are documented (no deployed appendages): the mode "known shape".
+SHAPES_CSV = DATA / "shapes.csv"
 #: Status of a case whose history the command line does not accept yet.
 HISTORY_NOT_SUPPORTED = "history not supported"
 #: Status of a history case whose sets gave no fit: the command predicted from the latest set alone.
@@ -196,6 +201,12 @@ def load_objects(data: Path = DATA) -> list[SpaceObject]:
                 )
             )
     return objects
+
+
+def load_shapes(path: Path = SHAPES_CSV) -> dict[int, list[str]]:
+    """NORAD number -> the command line's satellite flags (``--mass`` and the shape) of ``shapes.csv``."""
+    with open(path, newline="") as handle:
+        return {int(row["norad"]): ["--mass", row["mass_kg"], *row["shape"].split()] for row in csv.DictReader(handle)}
 
 
 # ---- choosing the cases (pure)
@@ -335,8 +346,12 @@ def predict(
     samples: int | None,
     folder: Path,
     drag_from: str | None = None,
+    satellite: Sequence[str] = (),
 ) -> Case:
-    """Run one case: the sets ``sets`` of ``obj`` in one file, predicted from set ``chosen``."""
+    """Run one case: the sets ``sets`` of ``obj`` in one file, predicted from set ``chosen``.
+
+    ``satellite``: the mode "known shape"'s flags (`load_shapes`).
+    """
     epoch = obj.sets[chosen].epoch
     base = {
         "norad": obj.norad,
@@ -354,6 +369,7 @@ def predict(
     argv = ["lifetime", "--tle", str(path), "--json"]
     if drag_from and mode == "one set":
         argv += ["--drag-from", drag_from]
+    argv += list(satellite)
     if samples:
         argv += ["--uncertainty", "--samples", str(samples)]
     clock = time.perf_counter()
@@ -396,8 +412,9 @@ def run_cases(
     samples: int | None,
     limit: int | None,
     drag_from: str | None = None,
+    shapes: dict[int, list[str]] | None = None,
 ) -> list[Case]:
-    """Every chosen case of ``objects`` (one set, and the history if asked), with progress lines on stderr."""
+    """Every chosen case of ``objects`` (one set; the history and the known shape if asked), progress on stderr."""
     plan = [(obj, k) for obj in objects for k in choose_sets([obj.lead_days(i) for i in range(len(obj.sets))])]
     if limit is not None:
         plan = plan[:limit]
@@ -406,9 +423,12 @@ def run_cases(
         for number, (obj, k) in enumerate(plan, start=1):
             epochs = [days_between(obj.sets[0].epoch, s.epoch) for s in obj.sets]
             runs = [("one set", [k])] + ([("history", history_indices(epochs, k))] if history else [])
+            satellite = (shapes or {}).get(obj.norad)
+            runs += [("known shape", [k])] if satellite else []
             notes = []
             for mode, sets in runs:
-                case = predict(obj, k, mode, sets, samples, Path(tmp), drag_from)
+                flags = satellite if mode == "known shape" else ()
+                case = predict(obj, k, mode, sets, samples, Path(tmp), drag_from, flags or ())
                 cases.append(case)
                 what = f"{case.error:+.1%}" if case.status == "ok" else case.status
                 notes.append(f"{mode} ({len(sets)} sets) {what} in {case.seconds:.1f} s")
@@ -438,30 +458,30 @@ def finite(value):
 
 
 def print_table(cases: Sequence[Case]) -> None:
-    print(f"{'norad':>6} {'name':<24} {'mode':<8} {'epoch':<16} {'lead d':>8} {'pred d':>9} {'error':>9} {'band':>5}")
+    print(f"{'norad':>6} {'name':<24} {'mode':<11} {'epoch':<16} {'lead d':>8} {'pred d':>9} {'error':>9} {'band':>5}")
     for c in cases:
         predicted = f"{c.predicted_days:9.1f}" if c.status == "ok" else f"{'-':>9}"
         error = f"{100.0 * c.error:+8.1f}%" if c.status == "ok" else f"{'-':>9}"
         band = {None: "-", True: "yes", False: "no"}[c.in_band]
         extra = "" if c.status == "ok" else f"  ({c.status})"
         print(
-            f"{c.norad:>6} {c.name[:24]:<24} {c.mode:<8} {c.epoch:%Y-%m-%d %H:%M} {c.lead_days:8.1f} "
+            f"{c.norad:>6} {c.name[:24]:<24} {c.mode:<11} {c.epoch:%Y-%m-%d %H:%M} {c.lead_days:8.1f} "
             f"{predicted} {error} {band:>5}{extra}"
         )
 
 
 def print_summary(summary: dict[str, dict]) -> None:
-    print(f"\n{'mode':<8} {'lead':<9} {'cases':>5} {'median|e|':>9} {'p90|e|':>9} {'<=25%':>7} {'in band':>12}")
+    print(f"\n{'mode':<11} {'lead':<9} {'cases':>5} {'median|e|':>9} {'p90|e|':>9} {'<=25%':>7} {'in band':>12}")
     for mode, parts in summary.items():
         rows = [("all", parts["all"]), *parts["by_lead"].items()]
         for label, m in rows:
             band = f"{percent(m['band_coverage'])} of {m['band_cases']}" if m["band_cases"] else "-"
             print(
-                f"{mode:<8} {label:<9} {m['cases']:>5} {percent(m['median_abs_error']):>9} "
+                f"{mode:<11} {label:<9} {m['cases']:>5} {percent(m['median_abs_error']):>9} "
                 f"{percent(m['p90_abs_error']):>9} {percent(m['within_25']):>7} {band:>12}"
             )
         statuses = ", ".join(f"{n} {s}" for s, n in sorted(parts["statuses"].items()))
-        print(f"{mode:<8} statuses: {statuses}")
+        print(f"{mode:<11} statuses: {statuses}")
 
 
 def write_rows(cases: Sequence[Case], path: str) -> None:
@@ -529,7 +549,7 @@ def plot(cases: Sequence[Case], path: str) -> None:
     for factor in (1.0 - WITHIN, 1.0 + WITHIN):
         ax.plot(lim, [factor * x for x in lim], "k--", lw=0.6)
     ax.plot([], [], "k--", lw=0.6, label="+-25%")
-    for mode, color in zip(MODES, ("tab:blue", "tab:orange"), strict=True):
+    for mode, color in zip(MODES, ("tab:blue", "tab:orange", "tab:green"), strict=True):
         mine = [c for c in done if c.mode == mode]
         if not mine:
             continue
@@ -571,6 +591,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--include-flagged", action="store_true", help="also run the flagged objects")
     parser.add_argument("--history", action="store_true", help="also predict from each case's history")
     parser.add_argument(
+        "--shapes", action="store_true", help="also predict with the documented mass and body of shapes.csv's objects"
+    )
+    parser.add_argument(
         "--uncertainty",
         action=argparse.BooleanOptionalAction,
         default=True,
@@ -605,6 +628,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         samples=args.samples if args.uncertainty else None,
         limit=args.limit_cases,
         drag_from=args.drag_from,
+        shapes=load_shapes() if args.shapes else None,
     )
     total = time.perf_counter() - clock
     summary = summarize(cases)

@@ -101,3 +101,37 @@ def test_a_shape_without_its_dimensions_or_with_anothers_is_refused(capsys, flag
     argv = ["lifetime", "--perigee", "400", "--apogee", "420", "--mass", "4", *flags]
     assert main(argv) == 2
     assert capsys.readouterr().err.startswith(f"orbit-env: error: {message}")
+
+
+@pytest.mark.parametrize("norad", [38855, 43137, 41478])
+def test_documented_cubesats_from_their_mass_and_form_factor_meet_their_reentries(norad, tmp_path):
+    # F-1, Fox-1D and NODES 1 (benchmarks/data/reentry_tles/shapes.csv: launch mass and form factor from
+    # public pages), flown from their latest set with that mass and body tumbling at random: each lands
+    # within +-25% of the observed remaining life (the issue's threshold; measured on 2026-12-07: -2.9%,
+    # +1.3% and +5.9%).
+    import benchmark_scripts
+
+    script = benchmark_scripts.load("validate_element_sets")
+    (obj,) = [o for o in script.load_objects() if o.norad == norad]
+    last = len(obj.sets) - 1
+    case = script.predict(obj, last, "known shape", [last], None, tmp_path, satellite=script.load_shapes()[norad])
+    assert case.status == "ok" and abs(case.error) <= 0.25, case
+
+
+@pytest.mark.slow
+def test_documented_cubesats_from_mass_and_shape_beat_their_element_sets():
+    # The whole "known shape" table (10 CubeSats, 18 cases, about a minute): measured on 2026-12-07 a median
+    # |error| of 7.8% and 94.4% of cases within +-25% with the documented satellite, against 14.7% and
+    # 83.3% from the same sets' B* alone. Held to the history's goals of issue 27 (median <= 10%, 90% within
+    # +-25%, the 90% band holding >= 85%): the satellite known does as well as a history of sets.
+    import benchmark_scripts
+
+    script = benchmark_scripts.load("validate_element_sets")
+    shapes = script.load_shapes()
+    objects = [o for o in script.load_objects() if o.norad in shapes]
+    cases = script.run_cases(objects, history=False, samples=200, limit=None, shapes=shapes)
+    known = script.summarize(cases)["known shape"]["all"]
+    assert known["cases"] == 18
+    assert known["median_abs_error"] <= 0.10
+    assert known["within_25"] >= 0.90
+    assert known["band_coverage"] >= 0.85
