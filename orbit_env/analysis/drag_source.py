@@ -152,7 +152,12 @@ def drag_source(
         if inputs.area_m2 is not None or inputs.mass_per_area_kg_m2 is not None:
             raise ValueError("--shape sets the area; do not give --area or --mass-per-area")
         report: dict[str, Any] = {"shape": body.description, "reference_area_m2": body.reference_area_m2}
-        if inputs.drag_coefficient is None and sphere_heights_km is not None:
+        if inputs.drag_coefficient is None and sphere_heights_km is None:  # a batch: no one orbit's gas
+            raise ValueError(
+                "--shape in a batch gives the satellite's area only: give --cx too (the free-molecular coefficient "
+                "is computed at one orbit, by orbit-env lifetime --shape without --batch)"
+            )
+        if inputs.drag_coefficient is None:
             cx, gas = shape_drag_coefficient(
                 body, sphere_heights_km, inclination_deg, scenario, ascending_node_local_time_h
             )

@@ -135,3 +135,20 @@ def test_documented_cubesats_from_mass_and_shape_beat_their_element_sets():
     assert known["median_abs_error"] <= 0.10
     assert known["within_25"] >= 0.90
     assert known["band_coverage"] >= 0.85
+
+
+def test_a_batch_takes_a_shapes_area_with_a_given_cx_and_says_it_computes_no_coefficient(capsys, tmp_path):
+    # A batch has no one orbit whose gas gives the free-molecular coefficient: it had flown the shape's area at
+    # the paper's c_x 2 without a word. It now asks for --cx, and with it flies the shape's area.
+    import csv
+
+    catalogue = tmp_path / "orbits.csv"
+    catalogue.write_text("name,perigee_km,apogee_km\na,400,420\n")
+    out = tmp_path / "out.csv"
+    argv = ["lifetime", "--batch", str(catalogue), "--out", str(out), "--no-progress", "--mass", "4"]
+    argv += ["--shape", "cubesat", "--form-factor", "3U"]
+    assert main(argv) == 2
+    assert "--shape in a batch gives the satellite's area only: give --cx too" in capsys.readouterr().err
+    assert main([*argv, "--cx", "2.2"]) == 0
+    (row,) = csv.DictReader(out.open())
+    assert float(row["drag_parameter_m2_kg"]) == pytest.approx(2.2 * 0.1562 / 4 / 4.0, rel=1e-5)  # six digits
