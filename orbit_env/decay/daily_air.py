@@ -65,6 +65,10 @@ STORM_AP_SLOTS = 27
 #: Days a forked process computes at a time (`DailyAirTable.log_density`'s ``after``): the rows it has finished
 #: are kept when it is stopped.
 BACKGROUND_PART = 30
+#: Days computed at once from which `DailyAirTable` shows a progress bar on a terminal (a first use of the
+#: solar task's table: every day since 1957, about 20 s on two cores), computing them this many at a time.
+PROGRESS_DAYS = 3000
+PROGRESS_PART = 1000
 #: A table is written again when it holds this many times the rows it held when last written (or read).
 STORE_GROWTH = 1.25
 _TABLES: weakref.WeakSet[DailyAirTable] = weakref.WeakSet()
@@ -172,6 +176,16 @@ class DailyAirTable:
         """
         # Daily-Ap days in one NRLMSIS call, storm days (longer keys) in another.
         new = sorted(new, key=len)
+        if len(new) >= PROGRESS_DAYS:  # years of air: a part at a time, with a bar (NRLMSIS is pointwise: same rows)
+            from tqdm import tqdm  # here: a command that computes no years of air does not import it
+
+            desc = "NRLMSIS air by day (computed once, then kept in the disk cache)"
+            rows = []
+            with tqdm(total=len(new), unit="day", desc=desc, disable=None, leave=False) as bar:
+                for start in range(0, len(new), PROGRESS_PART):
+                    rows.append(self._computed(new[start : start + PROGRESS_PART], columns)[1])
+                    bar.update(len(rows[-1]))
+            return new, np.concatenate(rows)
         daily = sum(len(key) == DAILY_KEY for key in new)
         rho = np.full((len(new), self.heights_m.size), np.nan)
         for part, storm in ((slice(0, daily), False), (slice(daily, None), True)):

@@ -65,6 +65,19 @@ def test_prefetched_days_are_held_and_asked_days_are_not_computed_twice(tmp_path
     np.testing.assert_allclose(np.exp(air.log_density(KEYS[::-1])[0]), direct(KEYS[2]), rtol=RTOL)
 
 
+def test_years_of_air_computed_a_part_at_a_time_are_the_rows_of_one_call(tmp_path, monkeypatch):
+    # A first use of years of days (the solar task's table) is computed in parts with a progress bar; NRLMSIS is
+    # pointwise and each row a day's own mean, so the parts give the rows of one call, to the bit, daily and
+    # storm days alike (a storm key's 27 ap after its four indices).
+    storm = (*KEYS[2], *np.linspace(20.0, 200.0, 27))
+    keys = [*KEYS, storm, (90.0, 95.0, 7.0, 40.0)]
+    whole = table(tmp_path / "whole", monkeypatch).log_density(keys)
+    monkeypatch.setattr(daily_air, "PROGRESS_DAYS", 3)
+    monkeypatch.setattr(daily_air, "PROGRESS_PART", 2)
+    parts = table(tmp_path / "parts", monkeypatch).log_density(keys)
+    np.testing.assert_array_equal(parts, whole)
+
+
 def test_a_new_process_reads_the_table_from_the_disk_cache_without_nrlmsis(tmp_path, monkeypatch):
     first = table(tmp_path, monkeypatch).log_density(KEYS)
     monkeypatch.setattr(daily_air, "orbit_mean_density_by_day_kg_m3", pytest.fail)
