@@ -174,6 +174,7 @@ def lifetime_spread(
     seed: int = 0,
     drag_sigma: float = DRAG_COEFFICIENT_SIGMA,
     workers: int = 1,
+    progress: bool = False,
 ) -> LifetimeSpread:
     """Monte Carlo lifetimes of one satellite (see the module docstring).
 
@@ -188,6 +189,8 @@ def lifetime_spread(
         drag_sigma: Log-normal sigma of the drag parameter: `DRAG_COEFFICIENT_SIGMA` for a
             satellite of known mass and area, `ONE_SET_DRAG_SIGMA` for one element set's.
         workers: Processes for the solar nodes (`propagate_nodes`); the results do not depend on it.
+        progress: A bar of the solar nodes done on standard error, if it is a terminal (a cold run of a long
+            life computes decades of each node's air: tens of seconds).
 
     Raises:
         ValueError: heights outside the universal curves' domain (metres, not km), a drag parameter
@@ -229,7 +232,7 @@ def lifetime_spread(
             runs.append((int(k), needed, model))
     orbit = (float(perigee_m), float(apogee_m), float(drag_parameter_m2_kg))
     for (k, needed, _), (days_k, reentered_k) in zip(
-        runs, propagate_nodes(orbit, runs, scale * scenario.density_scale, workers), strict=True
+        runs, propagate_nodes(orbit, runs, scale * scenario.density_scale, workers, progress), strict=True
     ):
         log_days[k, needed] = np.log(np.maximum(days_k, 1e-6))
         up[k, needed] = reentered_k
@@ -246,7 +249,11 @@ NodeRun = tuple[int, NDArray[np.intp], Any]
 
 
 def propagate_nodes(
-    orbit: tuple[float, float, float], runs: list[NodeRun], density_scale: FloatArray, workers: int
+    orbit: tuple[float, float, float],
+    runs: list[NodeRun],
+    density_scale: FloatArray,
+    workers: int,
+    progress: bool = False,
 ) -> list[tuple[FloatArray, NDArray[np.bool_]]]:
     """Each node's samples propagated (`orbit_env.decay.chunked.propagate`): their days and whether they re-entered.
 
@@ -255,25 +262,49 @@ def propagate_nodes(
     processes (`orbit_env.workers.worker_pool`: forked where it may) while this one runs the
     first (the nominal forecast's, whose air is in memory); the workers' new rows of the real
     Sun's air come back with their results (`orbit_env.decay.daily_air.merge_rows`). Each node
-    runs on its own arithmetic, so the results are the same bit for bit in any process.
+    runs on its own arithmetic, so the results are the same bit for bit in any process. ``progress``:
+    a bar of the nodes done on standard error, shown on a terminal only and cleared at the end.
     """
     from orbit_env.decay import daily_air
 
-    if workers <= 1 or len(runs) <= 1:
-        return [_propagate_node(orbit, model, density_scale[needed])[:2] for _, needed, model in runs]
-    from orbit_env.workers import worker_pool
+    bar = _nodes_bar(len(runs)) if progress else None
+    try:
+        if workers <= 1 or len(runs) <= 1:
+            results = []
+            for _, needed, model in runs:
+                results.append(_propagate_node(orbit, model, density_scale[needed])[:2])
+                _advance(bar)
+            return results
+        from orbit_env.workers import worker_pool
 
-    with worker_pool(min(workers, len(runs) - 1)) as pool:  # Ctrl-C or a failed node stops the workers now
-        futures = [
-            pool.submit(_propagate_node, orbit, model, density_scale[needed], True) for _, needed, model in runs[1:]
-        ]
-        _, needed, model = runs[0]
-        results = [_propagate_node(orbit, model, density_scale[needed])[:2]]
-        for future in futures:
-            days, reentered, rows = future.result()
-            daily_air.merge_rows(rows)
-            results.append((days, reentered))
-    return results
+        with worker_pool(min(workers, len(runs) - 1)) as pool:  # Ctrl-C or a failed node stops the workers now
+            futures = [
+                pool.submit(_propagate_node, orbit, model, density_scale[needed], True) for _, needed, model in runs[1:]
+            ]
+            _, needed, model = runs[0]
+            results = [_propagate_node(orbit, model, density_scale[needed])[:2]]
+            _advance(bar)
+            for future in futures:
+                days, reentered, rows = future.result()
+                daily_air.merge_rows(rows)
+                results.append((days, reentered))
+                _advance(bar)
+        return results
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _nodes_bar(total: int) -> Any:
+    """A tqdm bar of the solar nodes, on a terminal only (tqdm's ``disable=None``), cleared when closed."""
+    from tqdm import tqdm  # here: a command without --uncertainty does not import it
+
+    return tqdm(total=total, unit="node", desc="samples' solar nodes", disable=None, leave=False)
+
+
+def _advance(bar: Any) -> None:
+    if bar is not None:
+        bar.update(1)
 
 
 def _propagate_node(

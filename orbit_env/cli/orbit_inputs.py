@@ -458,6 +458,7 @@ def uncertainty(
         seed=args.seed,
         **({} if drag_sigma is None else {"drag_sigma": drag_sigma}),
         workers=args.workers or os.cpu_count() or 1,
+        progress=True,
     )
     epoch = result.epoch_days
     if epoch is None and orbit.elements is not None:

@@ -170,3 +170,32 @@ def test_nodes_in_worker_processes_give_the_same_lifetimes_and_hand_back_their_a
     np.testing.assert_array_equal(parallel.days, serial.days)
     np.testing.assert_array_equal(parallel.reentered, serial.reentered)
     assert np.all(serial.reentered)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_the_nodes_show_a_bar_on_a_terminal_only_and_clear_it(monkeypatch, workers):
+    # A cold --uncertainty over decades computes each node's air: tens of seconds that showed nothing. The
+    # command line asks for a bar of the nodes; tqdm draws it on a terminal only and clears it at the end, so
+    # the printed results are those of a run without it.
+    import io
+    import sys
+
+    from orbit_env.decay.solar import unix_days
+    from orbit_env.decay.solar_record import load_record
+
+    pytest.importorskip("pymsis")
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    scenario = Scenario(MsisAir(load_record(), unix_days("2024-01-01")), rotating_atmosphere=True)
+    runs = {}
+    for progress in (False, True):
+        screen = Terminal()
+        monkeypatch.setattr(sys, "stderr", screen)
+        spread = U.lifetime_spread(300e3, 320e3, 0.0165, scenario, 51.6, samples=50, workers=workers, progress=progress)
+        runs[progress] = (spread.days, screen.getvalue())
+    assert runs[False][1] == ""
+    assert "samples' solar nodes:   0%" in runs[True][1] and runs[True][1].endswith("\r")
+    np.testing.assert_array_equal(runs[True][0], runs[False][0])
