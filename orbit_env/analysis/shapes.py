@@ -47,6 +47,8 @@ SHAPES: tuple[str, ...] = tuple(SHAPE_DIMENSIONS)
 #: CubeSat envelopes [m] by form factor: the CubeSat Design Specification Rev. 14.1 (Cal Poly, 2022),
 #: as the cubesat-specs package tabulates it (PyPI, version 0.1.1's description: width x depth x height
 #: in mm). The structure with its rails and anything stowed; panels deployed in orbit are not included.
+#: The copy of that page read here cuts the 12U row after its second number: its 366 mm height is the
+#: 6U's, as the specification has it from memory.
 CUBESAT_FORM_FACTORS_M: dict[str, tuple[float, float, float]] = {
     "0.5U": (0.1, 0.1, 0.05675),
     "1U": (0.1, 0.1, 0.1135),
