@@ -7,6 +7,7 @@ Input columns (a header row; names case-insensitive, any order, extra columns ig
 | ``perigee_km`` | perigee height (required) |
 | ``apogee_km`` | apogee height (required) |
 | ``mass_kg``, ``area_m2`` | mass and reference area (together), or |
+| ``mass_kg``, ``form_factor`` | mass and a CubeSat's form factor (``3U``: its tumbling envelope's area), or |
 | ``mass_per_area_kg_m2`` | transverse load G/F, or |
 | ``drag_parameter_m2_kg`` | c = c_x A / m directly; a missing value: the CLI's satellite (``--mass``, ``--cx``, ...) |
 | ``cx`` | drag coefficient (default: ``--cx``) |
@@ -118,12 +119,24 @@ def _drag_parameter(row: dict[str, str], default_cx: float, default_c: float) ->
     c = _bounded(row, "drag_parameter_m2_kg", "m^2/kg", DRAG_PARAMETER_RANGE_M2_KG)
     load = _bounded(row, "mass_per_area_kg_m2", "kg/m^2", MASS_PER_AREA_RANGE_KG_M2)
     mass, area = _bounded(row, "mass_kg", "kg", MASS_RANGE_KG), _bounded(row, "area_m2", "m^2", AREA_RANGE_M2)
+    form_factor = row.get("form_factor", "").strip()
+    if form_factor:  # a CubeSat's envelope tumbling at random gives the area; c_x is the row's (or --cx)
+        from orbit_env.analysis.shapes import cubesat
+
+        if area is not None:
+            raise ValueError("the area is given twice (area_m2; form_factor): give one of them")
+        if mass is None:
+            raise ValueError("form_factor gives the area: give mass_kg with it")
+        area = cubesat(form_factor).reference_area_m2
     given = [
         name
         for name, present in (
             ("drag_parameter_m2_kg", c is not None),
             ("mass_per_area_kg_m2", load is not None),
-            ("mass_kg and area_m2", mass is not None or area is not None),
+            (
+                "mass_kg and area_m2" if not form_factor else "mass_kg and form_factor",
+                mass is not None or area is not None,
+            ),
         )
         if present
     ]

@@ -152,3 +152,24 @@ def test_a_batch_takes_a_shapes_area_with_a_given_cx_and_says_it_computes_no_coe
     assert main([*argv, "--cx", "2.2"]) == 0
     (row,) = csv.DictReader(out.open())
     assert float(row["drag_parameter_m2_kg"]) == pytest.approx(2.2 * 0.1562 / 4 / 4.0, rel=1e-5)  # six digits
+
+
+def test_a_catalogue_row_gives_a_cubesat_by_its_mass_and_form_factor(capsys, tmp_path):
+    # A constellation's CSV names its CubeSats' form factor: the area is the tumbling envelope's (a quarter of
+    # its surface), the coefficient the row's cx or --cx, as with mass_kg and area_m2.
+    import csv
+
+    catalogue = tmp_path / "orbits.csv"
+    rows = ["name,perigee_km,apogee_km,mass_kg,form_factor,area_m2,cx", "a,400,420,4,3U,,2.4", "b,400,420,4,3U,,"]
+    rows += ["no mass,400,420,,3U,,", "twice,400,420,4,3U,0.03,", "unknown,400,420,4,5U,,"]
+    catalogue.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "out.csv"
+    assert main(["lifetime", "--batch", str(catalogue), "--out", str(out), "--no-progress", "--cx", "2.2"]) == 1
+    capsys.readouterr()
+    got = {row["name"]: row for row in csv.DictReader(out.open())}
+    area = 0.1562 / 4  # 2 (0.01 + 2 x 0.03405) / 4
+    assert float(got["a"]["drag_parameter_m2_kg"]) == pytest.approx(2.4 * area / 4.0, rel=1e-5)  # six digits
+    assert float(got["b"]["drag_parameter_m2_kg"]) == pytest.approx(2.2 * area / 4.0, rel=1e-5)
+    assert got["no mass"]["status"] == "line 4: form_factor gives the area: give mass_kg with it"
+    assert got["twice"]["status"] == "line 5: the area is given twice (area_m2; form_factor): give one of them"
+    assert got["unknown"]["status"].startswith("line 6: unknown CubeSat form factor '5U'; known: 0.5U, 1U")
