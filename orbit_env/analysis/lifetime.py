@@ -9,6 +9,7 @@ from __future__ import annotations
 import datetime
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
@@ -244,6 +245,7 @@ def lifetime(
     epoch: str | float | datetime.date | np.datetime64 | None = None,
     ascending_node_local_time_h: float | None = None,
     chunk_days: float | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> LifetimeResult:
     """Lifetime of a satellite from perigee/apogee heights to re-entry (perigee 100 km).
 
@@ -284,6 +286,8 @@ def lifetime(
             local solar time (else local time is averaged over).
         chunk_days: Time step [days] of the time-stepped path (None: `DEFAULT_CHUNK_DAYS`); a keyword
             of the air like the others (a scenario carries its own), for a time-stepped decay only.
+        progress: A time-stepped decay by the curves calls it with the days decayed so far after each
+            chunk (the command line's bar of the years decayed; a cold decay over decades computes their air).
 
     Raises:
         TypeError: more than one orbit (arrays: see `Scenario.lifetime_days`), or a satellite or
@@ -336,7 +340,7 @@ def lifetime(
     method = method or default_method(scenario, hp_m, ha_m)
     if scenario.time_varying:
         result = _lifetime_under_activity(
-            hp_m, ha_m, satellite, method, scenario.density_scale, scenario.solar_model(inclination_deg)
+            hp_m, ha_m, satellite, method, scenario.density_scale, scenario.solar_model(inclination_deg), progress
         )
         solar = scenario.activity
         if isinstance(solar, TableActivity) and scenario.epoch_days is not None:
@@ -487,7 +491,13 @@ def _start_days(activity: SolarActivity, epoch: str | float | datetime.date | np
 
 
 def _lifetime_under_activity(
-    hp_m: float, ha_m: float, satellite: Satellite, method: str, scale: float, model: SolarDecayModel
+    hp_m: float,
+    ha_m: float,
+    satellite: Satellite,
+    method: str,
+    scale: float,
+    model: SolarDecayModel,
+    progress: Callable[[float], None] | None = None,
 ) -> LifetimeResult:
     """The time-stepped NRLMSIS lifetime (see `lifetime`; the caller checked the heights).
 
@@ -515,7 +525,7 @@ def _lifetime_under_activity(
         days = float(t[-1])
         reentered = days < model.max_years * DAYS_PER_YEAR
     else:
-        result = propagate(hp_m, ha_m, c, model, density_scale=scale, record=True)
+        result = propagate(hp_m, ha_m, c, model, density_scale=scale, record=True, clock=progress)
         days, reentered = float(result.days[0]), bool(result.reentered[0])
         inside = result.history_days < days
         t = np.append(result.history_days[inside], days)

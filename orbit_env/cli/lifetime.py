@@ -173,6 +173,41 @@ def _input_files(args: argparse.Namespace) -> list[tuple[str, str | None]]:
     return [(f"the input file of {name}", path) for name, path in files]
 
 
+class YearsBar:
+    """The years a dated decay has flown, on a terminal: drawn once the decay has run `YearsBar.AFTER_S`.
+
+    A cold decay over decades computes their air (38 s for a 700 km cubesat); a warm one takes a fraction of
+    a second and shows nothing (tqdm is imported only when the bar is drawn). Cleared when closed.
+    """
+
+    AFTER_S = 1.0
+    #: Seconds between two redrawings.
+    EVERY_S = 0.1
+
+    def __init__(self) -> None:
+        self.start = self.drawn = time.perf_counter()
+        self.bar: Any = None
+
+    def __call__(self, days: float) -> None:
+        """The decay has reached ``days`` after its epoch (`orbit_env.lifetime`'s ``progress``)."""
+        now = time.perf_counter()
+        if self.bar is None:
+            if now - self.start < self.AFTER_S:
+                return
+            from tqdm import tqdm
+
+            self.bar = tqdm(desc="years decayed", bar_format="{desc}: {n:.1f} [{elapsed}]", leave=False)
+        elif now - self.drawn < self.EVERY_S:
+            return
+        self.bar.n, self.drawn = round(days / DAYS_PER_YEAR, 1), now
+        self.bar.refresh()
+
+    def close(self) -> None:
+        """Clear the bar, if drawn."""
+        if self.bar is not None:
+            self.bar.close()
+
+
 def _cmd_lifetime(args: argparse.Namespace) -> int:
     args.inclination_defaulted = args.inclination is None and not getattr(args, "tle", None)
     _check_inclination(args)
@@ -198,16 +233,22 @@ def _cmd_lifetime(args: argparse.Namespace) -> int:
     if args.uncertainty:
         _check_on_the_curves(perigee_km, apogee_km, offset)
     air = scenario.in_sphere_heights(orbit.reference, args.inclination)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SolarTableWarning)  # said below, as the command's warnings are
-        result = lifetime(
-            perigee_km,
-            apogee_km,
-            satellite=satellite,
-            scenario=air,
-            method=args.method,
-            inclination_deg=args.inclination,
-        )
+    years = YearsBar() if air.time_varying and sys.stderr.isatty() else None
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SolarTableWarning)  # said below, as the command's warnings are
+            result = lifetime(
+                perigee_km,
+                apogee_km,
+                satellite=satellite,
+                scenario=air,
+                method=args.method,
+                inclination_deg=args.inclination,
+                progress=years,
+            )
+    finally:
+        if years is not None:
+            years.close()
     if scenario.epoch_days is not None:
         _warn_solar_table(scenario, scenario.epoch_days + result.days)
     summary = result.to_dict()

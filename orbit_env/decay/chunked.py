@@ -765,6 +765,7 @@ def propagate(
     progress: Callable[[float], None] | None = None,
     inclination_deg: ArrayLike | None = None,
     start_days: ArrayLike | None = None,
+    clock: Callable[[float], None] | None = None,
 ) -> SolarLifetime:
     """Propagate satellites to re-entry under the activity of ``model`` (see the module docstring).
 
@@ -804,6 +805,8 @@ def propagate(
         progress: Called with the fraction of satellites re-entered after each chunk.
         inclination_deg: Each satellite's inclination (default: the model's).
         start_days: Each satellite's start [days after the model's epoch, >= 0] (default 0).
+        clock: Called with the days from the model's epoch reached after each chunk (one satellite's progress,
+            which ``progress`` cannot show; orbits of both kinds, near-circular and wider, run it once each).
 
     Raises:
         ValueError: ``start_days`` negative or not finite, or given with ``record``.
@@ -827,7 +830,7 @@ def propagate(
     near = (ha - hp <= NEAR_CIRCULAR_SPAN_M) if model.near_circular_bins else np.zeros(hp.size, dtype=bool)
     if near.all() or not near.any() or record:
         fixed = model.near_circular() if near.size and near.all() else model
-        return _propagate(hp, ha, c, scale, fixed, record, progress, inclination_deg, start)
+        return _propagate(hp, ha, c, scale, fixed, record, progress, inclination_deg, start, clock)
     days, reentered, bins_used, done = np.empty(hp.size), np.empty(hp.size, dtype=bool), 0, 0
     for group, group_model in ((near, model.near_circular()), (~near, model)):
         count = int(group.sum())
@@ -847,6 +850,7 @@ def propagate(
             group_progress,
             inclination,
             None if start is None else start[group],
+            clock,
         )
         days[group], reentered[group] = result.days, result.reentered
         bins_used, done = bins_used + result.bins_used, done + count
@@ -863,6 +867,7 @@ def _propagate(
     progress: Callable[[float], None] | None,
     inclination_deg: ArrayLike | None,
     start_days: FloatArray | None = None,
+    clock: Callable[[float], None] | None = None,
 ) -> SolarLifetime:
     """`propagate` on the bins of ``model`` for every satellite."""
     hp, ha = hp.copy(), ha.copy()
@@ -980,6 +985,8 @@ def _propagate(
             history_ha.append(ha.copy())
         if progress is not None:
             progress(1.0 - (active.size + waiting.size) / n)
+        if clock is not None:
+            clock(t0 + model.chunk_days)
         k += 1
     reentered = np.isfinite(reentry)
     return SolarLifetime(

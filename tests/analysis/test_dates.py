@@ -81,3 +81,41 @@ def test_a_dated_decays_history_counts_the_revolutions_each_row_has_flown():
     assert np.all(flown >= gaps / period[:-1] * (1 - 1e-12)) and np.all(flown <= gaps / period[1:] * (1 + 1e-12))
     assert history.revolutions[-1] == result.revolutions and history.revolutions[0] == 0.0
     assert history.nu_remaining[0] == pytest.approx(result.nu, rel=1e-12) and history.nu_remaining[-1] == 0.0
+
+
+def test_a_dated_lifetime_reports_the_days_it_has_reached_and_a_terminal_shows_the_years(monkeypatch, capsys):
+    # A cold decay over decades computes their air (38 s for a 700 km cubesat) and showed nothing. lifetime's
+    # progress gets the days reached after each chunk, up to the life; the command draws them as years on a
+    # terminal once a decay has run a second, and clears them; the results are those of a run without it.
+    import io
+    import sys
+
+    from orbit_env import Satellite, lifetime
+    from orbit_env.analysis.air import MsisAir
+    from orbit_env.analysis.scenario import Scenario
+    from orbit_env.cli import lifetime as command
+    from orbit_env.decay.solar import unix_days
+    from orbit_env.decay.solar_record import load_record
+
+    pytest.importorskip("pymsis")
+    reached = []
+    scenario = Scenario(MsisAir(load_record(), unix_days("2024-01-01")), rotating_atmosphere=True)
+    result = lifetime(300, 320, satellite=Satellite(2.2, 4.0, 0.03), scenario=scenario, progress=reached.append)
+    # One call a 20-day chunk, the last at the end of the chunk that holds the re-entry.
+    assert reached == [20.0 * (k + 1) for k in range(len(reached))] and result.days <= reached[-1] < result.days + 20
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    argv = ["lifetime", "--perigee", "300", "--apogee", "320", "--mass", "4", "--area", "0.03", "--epoch"]
+    argv += ["2024-01-01", "--inclination", "51.6"]
+    assert main(argv) == 0
+    plain = capsys.readouterr().out
+    screen = Terminal()
+    monkeypatch.setattr(sys, "stderr", screen)
+    monkeypatch.setattr(command.YearsBar, "AFTER_S", 0.0)
+    assert main(argv) == 0
+    assert capsys.readouterr().out == plain
+    drawn = screen.getvalue()
+    assert drawn.startswith("\ryears decayed: 0.") and drawn.endswith("\r")
