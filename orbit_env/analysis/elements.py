@@ -397,15 +397,17 @@ _OMM_BOUNDS = {
 def omm_format(text: str) -> str | None:
     """``"json"``, ``"xml"`` or ``"csv"`` for an OMM text, else None (a TLE's text, or none's).
 
-    Told by the first characters, or for CSV by a header naming NORAD_CAT_ID and EPOCH.
+    Told by the first characters, or for CSV by a header naming the elements (NORAD_CAT_ID, EPOCH,
+    MEAN_MOTION, ECCENTRICITY) and no ``perigee_km``: a catalogue of orbits may carry a catalogue
+    number and an epoch among its columns.
     """
     start = text.lstrip()
     if start.startswith(("[", "{")):
         return "json"
     if start.startswith("<"):
         return "xml"
-    header = start.split("\n", 1)[0].upper()
-    if "," in header and "NORAD_CAT_ID" in header and "EPOCH" in header:
+    header = {name.strip().strip('"').upper() for name in start.split("\n", 1)[0].split(",")}
+    if {"NORAD_CAT_ID", "EPOCH", "MEAN_MOTION", "ECCENTRICITY"} <= header and "PERIGEE_KM" not in header:
         return "csv"
     return None
 

@@ -142,6 +142,9 @@ def test_a_catalogue_csv_is_not_taken_for_omm_records(tmp_path):
     catalogue = tmp_path / "orbits.csv"
     catalogue.write_text("name,perigee_km,apogee_km,epoch\nsat,400,420,2024-01-01\n")
     assert not holds_element_sets(catalogue)
+    # A catalogue that carries each row's catalogue number and epoch is still a catalogue of orbits.
+    catalogue.write_text("name,norad_cat_id,epoch,perigee_km,apogee_km\nsat,25544,2024-01-01,400,420\n")
+    assert not holds_element_sets(catalogue)
     records = tmp_path / "records.csv"
     records.write_text(sgp4_tests.MARIO_CSV)
     assert holds_element_sets(records)
