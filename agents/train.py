@@ -10,13 +10,16 @@ output with the default file::
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import re
+import signal
+import threading
 import time
 import tomllib
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -543,12 +546,37 @@ def _written_whole(path: Path, write: Callable[[Path], object]) -> None:
     """``write(file)`` into ``.partial/`` beside ``path``, then the file moved to ``path`` (a rename: whole or absent).
 
     For the files a library writes by its name (SB3's zip, VecNormalize's pickle); text goes through
-    `orbit_env.analysis.catalogue_io.atomic_text`.
+    `orbit_env.analysis.catalogue_io.atomic_text`. Ctrl-C and SIGTERM wait for the write (`_interrupts_held`).
     """
     partial = path.parent / ".partial"
     partial.mkdir(parents=True, exist_ok=True)
-    write(partial / path.name)
-    (partial / path.name).replace(path)
+    with _interrupts_held():
+        write(partial / path.name)
+        (partial / path.name).replace(path)
+
+
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM arriving in the block are delivered when it ends, as they would have been.
+
+    An interrupt inside torch's zip writer had been replaced by the writer's own error on closing the
+    cut file ("unexpected pos"), so a SIGTERM during a checkpoint ended training with a traceback and
+    exit status 1 instead of the interrupted run's checkpoint and 130. Python runs signal handlers in the
+    main thread only: elsewhere the block runs as it is.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    held = [s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) is not None]
+    previous = {s: signal.signal(s, lambda signum, frame: caught.append(signum)) for s in held}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        for signum in caught:
+            signal.raise_signal(signum)  # to the handler the block held it from (KeyboardInterrupt, the CLI's, ...)
 
 
 def _save_whole(model: Any, path: Path) -> None:

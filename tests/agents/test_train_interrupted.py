@@ -229,3 +229,29 @@ def test_the_settings_a_resume_checks_are_its_runs_wherever_the_checkpoint_file_
     inside.write_bytes(copy.read_bytes())
     with pytest.raises(ValueError, match="is not a training run's settings"):
         train(config, tmp_path / "other", resume=inside, progress=False)
+
+
+def test_an_interrupt_during_a_files_write_waits_for_the_file_then_stops_the_run(tmp_path):
+    # A SIGTERM inside torch's zip writer had been replaced by the writer's own error ("unexpected pos") on
+    # closing the cut file: the run ended with a traceback and status 1, not its checkpoint and 130 (seen in
+    # CI, test_sigterm_stops_training_as_ctrl_c_does). The signal now waits for the write, then acts as before.
+    import orbit_env.agents.train as train_module
+
+    written = []
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    def write(file):
+        os.kill(os.getpid(), signal.SIGTERM)  # arrives mid-write
+        time.sleep(0.05)  # (delivered here, were it not held)
+        file.write_text("whole")
+        written.append(file)
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            train_module._written_whole(tmp_path / "model.zip", write)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert written and (tmp_path / "model.zip").read_text() == "whole"
