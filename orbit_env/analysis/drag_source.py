@@ -198,7 +198,8 @@ def shape_of(inputs: SatelliteInputs) -> Any:
     def flag(name: str) -> str:
         return "--" + name.replace("_", "-")
 
-    dimensions = {name: getattr(inputs, name) for name in ("diameter_m", "length_m", "size_m", "form_factor")}
+    names = dict.fromkeys(name for takes in SHAPE_DIMENSIONS.values() for name in takes)  # each once, in order
+    dimensions = {name: getattr(inputs, name) for name in names}
     needs = SHAPE_DIMENSIONS.get(inputs.shape or "", ())
     for name, value in dimensions.items():
         if value is not None and name not in needs:

@@ -383,14 +383,19 @@ OMM_FIELDS = (
     "MEAN_MOTION_DOT",
     "MEAN_MOTION_DDOT",
 )
-#: The bounds of an OMM's numbers, those of the same fields of a TLE (`_FIELDS`); the eccentricity's top excluded.
+#: The OMM keywords of the TLE's fields that `_FIELDS` bounds.
+_OMM_OF_TLE_FIELD = {
+    "inclination [deg]": "INCLINATION",
+    "right ascension of the ascending node [deg]": "RA_OF_ASC_NODE",
+    "argument of perigee [deg]": "ARG_OF_PERICENTER",
+    "mean anomaly [deg]": "MEAN_ANOMALY",
+    "mean motion [rev/day]": "MEAN_MOTION",
+}
+#: The bounds of an OMM's numbers: those of the same fields of a TLE (`_FIELDS`, whose seven eccentricity digits
+#: bound it by their form), and the eccentricity's, its top excluded.
 _OMM_BOUNDS = {
-    "MEAN_MOTION": (0.0, 20.0),
+    **{_OMM_OF_TLE_FIELD[field]: (low, high) for *_, field, _, low, high in _FIELDS if field in _OMM_OF_TLE_FIELD},
     "ECCENTRICITY": (0.0, 1.0),
-    "INCLINATION": (0.0, 180.0),
-    "RA_OF_ASC_NODE": (0.0, 360.0),
-    "ARG_OF_PERICENTER": (0.0, 360.0),
-    "MEAN_ANOMALY": (0.0, 360.0),
 }
 
 

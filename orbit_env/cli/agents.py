@@ -111,10 +111,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         dp_rollout=args.dp_rollout,
         learned_name=args.name,
     )
-    for name, policy in own.items():
-        if name in policies:
-            raise ValueError(f"--policy: {name} is the name of a row of the evaluation; give the policy another name")
-        policies[name] = policy
+    policies.update(own)  # (their names checked against every other row's by `_own_policies`)
     results, table = evaluate(args.env, policies, args.episodes, args.seed, progress=say)
     if args.plot is not None:
         plot_returns(results, args.env, args.plot)
@@ -210,10 +207,7 @@ def _evaluate_solar(args: argparse.Namespace, say: Any, own: dict[str, Any]) -> 
     # The shipped PPO, or --model's; loaded (and its spaces checked) before the DPs' minutes.
     loaded = load_model(args.env, args.model, warn=lambda text: print(f"{PROG}: warning: {text}", file=sys.stderr))
     learned = {} if loaded is None else {args.name or loaded[0]: loaded[1]}
-    for name, policy in own.items():  # flown as the learned agents are, from the observations
-        if name in learned:
-            raise ValueError(f"--policy: {name} is the name of a row of the evaluation; give the policy another name")
-        learned[name] = policy
+    learned.update(own)  # flown as the learned agents are, from the observations (names checked: `_own_policies`)
     evaluation = evaluate_solar(
         args.episodes,
         args.seed,

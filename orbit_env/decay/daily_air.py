@@ -66,7 +66,7 @@ STORM_AP_SLOTS = 27
 #: are kept when it is stopped.
 BACKGROUND_PART = 30
 #: Days computed at once from which `DailyAirTable` shows a progress bar on a terminal (a first use of the
-#: solar task's table: every day since 1957, about 20 s on two cores), computing them this many at a time.
+#: solar task's table: every day since 1957, about 15 s on two cores), computing them this many at a time.
 PROGRESS_DAYS = 3000
 PROGRESS_PART = 1000
 #: A table is written again when it holds this many times the rows it held when last written (or read).
